@@ -1,0 +1,131 @@
+#pragma once
+
+#include <stdexcept>
+
+#include "projection_collision_avoidance/BallConstraint.hpp"
+#include "projection_collision_avoidance/ControllerDesign.hpp"
+#include "projection_collision_avoidance/ProjectionOperator.hpp"
+#include "projection_collision_avoidance/TypeDefs.hpp"
+
+namespace projection_collision_avoidance {
+
+/// What happened to the estimate over one control period.
+struct EstimatorPeriodReport {
+  bool projection_active = false;   ///< the projection changed the drift in some substep
+  double boundary_correction = 0.0; ///< largest distance (m) by which a substep's result was
+                                    ///< moved back onto the sphere ||xi_hat|| = xi_max
+};
+
+/// The collision-free (CF) estimator: a Luenberger observer of the relative error xi whose drift
+/// (11) is wrapped in the Gamma-weighted projection operator, so that ||xi_hat|| <= xi_max.
+///
+/// Between two control ticks the measurement y and the tracker input u_a are held; the estimate
+/// is integrated with classical Runge-Kutta (RK4) substeps of the projected drift. The flow
+/// keeps Omega_1 invariant; RK4 can leave it by its local truncation error (order h^5), and any
+/// such excess is removed by scaling the estimate back onto the sphere, so ||xi_hat|| <= xi_max
+/// holds exactly after every substep. The size of that correction is reported.
+template <typename Dims>
+class CollisionFreeEstimator {
+ public:
+  using StateVector = typename Dims::StateVector;
+  using InputVector = typename Dims::InputVector;
+  using OutputVector = typename Dims::OutputVector;
+  using StateMatrix = typename Dims::StateMatrix;
+  using InputMatrix = typename Dims::InputMatrix;
+  using ObserverGainMatrix = typename Dims::ObserverGainMatrix;
+
+  /// @param design validated parameters; their sizes must match Dims (std::invalid_argument)
+  explicit CollisionFreeEstimator(const ControllerDesign& design)
+      : constraint_(design.xi_max, design.parameters.epsilon) {
+    const Eigen::Index n = design.parameters.model.stateDimension();
+    const Eigen::Index m = design.parameters.model.inputDimension();
+    const Eigen::Index p = design.parameters.model.outputDimension();
+    if ((Dims::kStates != Eigen::Dynamic && Dims::kStates != n) ||
+        (Dims::kInputs != Eigen::Dynamic && Dims::kInputs != m) ||
+        (Dims::kOutputs != Eigen::Dynamic && Dims::kOutputs != p) ||
+        n > Dims::kMaxStates || m > Dims::kMaxInputs || p > Dims::kMaxOutputs) {
+      throw std::invalid_argument("CollisionFreeEstimator: model sizes do not fit the dimensions");
+    }
+    estimator_matrix_ = design.estimator_matrix;
+    input_matrix_ = design.parameters.model.B;
+    observer_gain_ = design.parameters.estimator_gain;
+    gamma_inverse_ = design.gamma_inverse;
+    estimate_ = StateVector::Zero(n);
+  }
+
+  /// Sets the estimate, scaled into Omega_1 if it lies outside.
+  void reset(const StateVector& estimate) {
+    estimate_ = estimate;
+    moveIntoBound(&estimate_);
+  }
+
+  /// The current estimate xi_hat (m).
+  const StateVector& estimate() const { return estimate_; }
+
+  const BallConstraint& constraint() const { return constraint_; }
+
+  /// Unprojected drift (11): h = A_c xi_hat - B u_a + L (C xi_hat - y) + w, written as
+  /// (A_c + L C) xi_hat + c with c = -B u_a - L y + w.
+  /// @param w known input drift (m/s), B (u_1 - u_ff) when the leader's input is shared, else 0
+  StateVector heldInput(const OutputVector& y, const InputVector& tracker_input,
+                        const StateVector& w) const {
+    return w - input_matrix_ * tracker_input - observer_gain_ * y;
+  }
+
+  /// Projected derivative xi_hat' at @p estimate for the held input c (m/s).
+  StateVector derivative(const StateVector& estimate, const StateVector& held_input,
+                         bool* active) const {
+    const StateVector drift = estimator_matrix_ * estimate + held_input;
+    return projectDrift(constraint_, estimate, drift, gamma_inverse_, active);
+  }
+
+  /// Advances the estimate over one control period with y and u_a held (15).
+  /// @param y relative measurement C xi at the start of the period
+  /// @param tracker_input u_a applied over the period (m/s^2)
+  /// @param w known input drift (m/s), see heldInput()
+  /// @param period control period T (s), > 0
+  /// @param substeps number of RK4 steps, >= 1
+  EstimatorPeriodReport advance(const OutputVector& y, const InputVector& tracker_input,
+                                const StateVector& w, double period, int substeps) {
+    EstimatorPeriodReport report;
+    const StateVector held = heldInput(y, tracker_input, w);
+    const double h = period / substeps;
+    for (int i = 0; i < substeps; ++i) {
+      const StateVector k1 = derivative(estimate_, held, &report.projection_active);
+      const StateVector k2 =
+          derivative(estimate_ + (0.5 * h) * k1, held, &report.projection_active);
+      const StateVector k3 =
+          derivative(estimate_ + (0.5 * h) * k2, held, &report.projection_active);
+      const StateVector k4 = derivative(estimate_ + h * k3, held, &report.projection_active);
+      estimate_ += (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+      const double correction = moveIntoBound(&estimate_);
+      report.boundary_correction = std::max(report.boundary_correction, correction);
+    }
+    return report;
+  }
+
+ private:
+  /// Scales @p x onto the sphere of radius xi_max if it lies outside; returns the distance moved.
+  double moveIntoBound(StateVector* x) const {
+    const double radius = constraint_.hardRadius();
+    const double norm = x->norm();
+    if (!(norm > radius)) {
+      return 0.0;
+    }
+    *x *= radius / norm;
+    // Rounding can leave the scaled vector an ulp outside; shrink until it is not.
+    while (x->norm() > radius) {
+      *x *= 1.0 - 2.0 * Eigen::NumTraits<double>::epsilon();
+    }
+    return norm - radius;
+  }
+
+  BallConstraint constraint_;
+  StateMatrix estimator_matrix_;     // A_c + L C
+  InputMatrix input_matrix_;         // B
+  ObserverGainMatrix observer_gain_; // L
+  StateMatrix gamma_inverse_;        // Gamma^-1
+  StateVector estimate_;
+};
+
+}  // namespace projection_collision_avoidance

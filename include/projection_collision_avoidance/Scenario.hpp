@@ -1,0 +1,26 @@
+#pragma once
+
+#include <Eigen/Core>
+
+#include "projection_collision_avoidance/ControllerParameters.hpp"
+#include "projection_collision_avoidance/SignalProfile.hpp"
+
+namespace projection_collision_avoidance {
+
+/// A leader-follower run: the follower's controller parameters, both agents' initial states,
+/// the leader's input and disturbance, and the duration. Loaded from the YAML format of
+/// doc/scenario_format.md by loadScenario() (scenario library).
+struct Scenario {
+  ControllerParameters controller;
+  Eigen::VectorXd leader_initial_state;    ///< x_1(0), n
+  Eigen::VectorXd follower_initial_state;  ///< x_2(0), n
+  SignalProfile leader_input;              ///< u_1(t), m; sampled at each control tick
+  SignalProfile disturbance;               ///< u_d(t), n; x_1' = A x_1 + B u_1 + u_d
+  double duration = 0.0;                   ///< s
+
+  /// Checks the parts that ControllerDesign::create() does not: initial states, signals and
+  /// duration. Throws ParameterError naming "leader.*", "follower.*" or "simulation.duration".
+  void validate() const;
+};
+
+}  // namespace projection_collision_avoidance

@@ -1,0 +1,13 @@
+/// cf_sim: runs a scenario's closed loop without ROS and prints one summary line.
+/// Usage: cf_sim SCENARIO.yaml [--set key=value]... [--csv FILE]
+
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "projection_collision_avoidance/CfSimApp.hpp"
+
+int main(int argc, char** argv) {
+  const std::vector<std::string> arguments(argv + 1, argv + argc);
+  return projection_collision_avoidance::runCfSim(arguments, std::cout, std::cerr);
+}

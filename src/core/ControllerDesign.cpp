@@ -1,0 +1,158 @@
+#include "projection_collision_avoidance/ControllerDesign.hpp"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <Eigen/SVD>
+#include <cmath>
+
+#include "ValidationChecks.hpp"
+#include "projection_collision_avoidance/LinearAlgebra.hpp"
+#include "projection_collision_avoidance/ParameterError.hpp"
+
+namespace projection_collision_avoidance {
+namespace {
+
+constexpr int kMaxEstimatorSubsteps = 1000;
+constexpr double kRelativeTolerance = 1e-9;
+
+void requireHurwitz(const std::string& key, const std::string& name, const Eigen::MatrixXd& M) {
+  if (!isHurwitz(M)) {
+    throw ParameterError(key, name + " is not Hurwitz; its eigenvalues are " +
+                                  formatEigenvalues(eigenvalues(M)));
+  }
+}
+
+void validateScalars(const ControllerParameters& p) {
+  detail::requireFinite("controller.control_rate", p.control_rate);
+  if (p.control_rate <= 0.0) {
+    throw ParameterError("controller.control_rate", "must be positive (Hz)");
+  }
+  detail::requireFinite("controller.alpha", p.alpha);
+  if (p.alpha < 0.0 || p.alpha >= 1.0) {
+    throw ParameterError("controller.alpha",
+                         "must lie in [0, 1), got " + std::to_string(p.alpha));
+  }
+  detail::requireFinite("controller.epsilon", p.epsilon);
+  if (p.epsilon <= 0.0) {
+    throw ParameterError("controller.epsilon",
+                         "must be positive, got " + std::to_string(p.epsilon));
+  }
+  if (p.estimator_substeps < 1 || p.estimator_substeps > kMaxEstimatorSubsteps) {
+    throw ParameterError("controller.estimator.substeps",
+                         "must be between 1 and " + std::to_string(kMaxEstimatorSubsteps) +
+                             ", got " + std::to_string(p.estimator_substeps));
+  }
+}
+
+void validateSeparation(const ControllerParameters& p) {
+  const AgentModel& model = p.model;
+  detail::requireVector("controller.separation", p.separation, model.stateDimension());
+  const double norm = p.separation.norm();
+  if (!(norm > 0.0)) {
+    throw ParameterError("controller.separation",
+                         "must be non-zero: the bound (1 - alpha) ||d|| would be zero");
+  }
+  const double drift = (model.A * p.separation).norm();
+  if (drift > kRelativeTolerance * (1.0 + model.A.norm()) * norm) {
+    throw ParameterError("controller.separation",
+                         "must lie in ker(A), but ||A d|| = " + std::to_string(drift));
+  }
+}
+
+void validateLyapunovWeight(const Eigen::MatrixXd& Q) {
+  const std::string key = "controller.estimator.lyapunov_weight";
+  if ((Q - Q.transpose()).norm() > kRelativeTolerance * (1.0 + Q.norm())) {
+    throw ParameterError(key, "must be symmetric");
+  }
+  const Eigen::VectorXd values = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(Q).eigenvalues();
+  if (!(values.minCoeff() > 0.0)) {
+    throw ParameterError(key, "must be positive definite; its smallest eigenvalue is " +
+                                  std::to_string(values.minCoeff()));
+  }
+}
+
+}  // namespace
+
+Eigen::MatrixXd doubleIntegratorGain(const Eigen::VectorXd& natural_frequency,
+                                     const Eigen::VectorXd& damping, const std::string& key) {
+  const Eigen::Index axes = natural_frequency.size();
+  if (axes < 1 || damping.size() != axes) {
+    throw ParameterError(key, "natural_frequency and damping need one value per axis");
+  }
+  if (!natural_frequency.allFinite() || !damping.allFinite() ||
+      natural_frequency.minCoeff() <= 0.0 || damping.minCoeff() <= 0.0) {
+    throw ParameterError(key, "natural_frequency and damping must be positive and finite");
+  }
+  Eigen::MatrixXd gain = Eigen::MatrixXd::Zero(axes, 2 * axes);
+  for (Eigen::Index i = 0; i < axes; ++i) {
+    gain(i, i) = natural_frequency(i) * natural_frequency(i);
+    gain(i, axes + i) = 2.0 * damping(i) * natural_frequency(i);
+  }
+  return gain;
+}
+
+ControllerDesign ControllerDesign::create(const ControllerParameters& parameters) {
+  const ControllerParameters& p = parameters;
+  validateAgentModel(p.model);
+  validateScalars(p);
+  validateSeparation(p);
+
+  const Eigen::Index n = p.model.stateDimension();
+  const Eigen::Index m = p.model.inputDimension();
+  const Eigen::Index q = p.model.outputDimension();
+  detail::requireMatrix("controller.baseline.gain", p.baseline_gain, m, q);
+  detail::requireMatrix("controller.estimator.gain", p.estimator_gain, n, q);
+  detail::requireMatrix("controller.estimator.lyapunov_weight", p.lyapunov_weight, n, n);
+  detail::requireMatrix("controller.tracker.gain", p.tracker_gain, m, q);
+  detail::requireMatrix("controller.tracker.reference_gain", p.reference_gain, m, q);
+  validateLyapunovWeight(p.lyapunov_weight);
+
+  ControllerDesign design;
+  design.parameters = p;
+  const Eigen::MatrixXd& A = p.model.A;
+  const Eigen::MatrixXd& B = p.model.B;
+  const Eigen::MatrixXd& C = p.model.C;
+
+  design.closed_loop = A - B * p.baseline_gain * C;
+  requireHurwitz("controller.baseline.gain", "A_c = A - B G C", design.closed_loop);
+  design.estimator_matrix = design.closed_loop + p.estimator_gain * C;
+  requireHurwitz("controller.estimator.gain", "A_c + L C", design.estimator_matrix);
+  design.tracking_matrix = design.closed_loop - B * p.tracker_gain * C;
+  if (p.tracker_enabled) {
+    requireHurwitz("controller.tracker.gain", "A_c - B G_e C", design.tracking_matrix);
+  }
+
+  design.gamma =
+      solveContinuousLyapunov(design.estimator_matrix, p.lyapunov_weight, &design.lyapunov_residual);
+  if (!(design.lyapunov_residual < 1e-8)) {
+    throw ParameterError("controller.estimator.lyapunov_weight",
+                         "the Lyapunov equation for Gamma is ill-conditioned (relative residual " +
+                             std::to_string(design.lyapunov_residual) + ")");
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> gamma_eigen(design.gamma);
+  const double gamma_min = gamma_eigen.eigenvalues().minCoeff();
+  const double gamma_max = gamma_eigen.eigenvalues().maxCoeff();
+  if (!(gamma_min > 0.0)) {
+    throw ParameterError("controller.estimator.lyapunov_weight",
+                         "Gamma is not positive definite (smallest eigenvalue " +
+                             std::to_string(gamma_min) + ")");
+  }
+  design.gamma_inverse = gamma_eigen.eigenvectors() *
+                         gamma_eigen.eigenvalues().cwiseInverse().asDiagonal() *
+                         gamma_eigen.eigenvectors().transpose();
+  const double q_min =
+      Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(p.lyapunov_weight).eigenvalues().minCoeff();
+  design.estimator_decay_rate = q_min / (2.0 * gamma_max);
+  design.estimator_overshoot = std::sqrt(gamma_max / gamma_min);
+
+  design.output_pseudoinverse =
+      C.completeOrthogonalDecomposition().pseudoInverse();
+  design.period = 1.0 / p.control_rate;
+  const double d_norm = p.separation.norm();
+  design.xi_max = (1.0 - p.alpha) * d_norm;
+  design.xi_soft = design.xi_max / std::sqrt(1.0 + p.epsilon);
+  design.perimeter = p.alpha * d_norm;
+  return design;
+}
+
+}  // namespace projection_collision_avoidance

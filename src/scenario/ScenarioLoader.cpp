@@ -1,0 +1,276 @@
+#include "projection_collision_avoidance/ScenarioLoader.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "YamlReader.hpp"
+#include "projection_collision_avoidance/ControllerDesign.hpp"
+#include "projection_collision_avoidance/ParameterError.hpp"
+
+namespace projection_collision_avoidance {
+namespace {
+
+void setAtPath(YAML::Node node, const std::vector<std::string>& path, std::size_t index,
+               const YAML::Node& value, const std::string& full_key) {
+  const std::string& element = path[index];
+  const bool last = index + 1 == path.size();
+  if (node.IsSequence()) {
+    std::size_t position = 0;
+    try {
+      std::size_t consumed = 0;
+      position = std::stoul(element, &consumed);
+      if (consumed != element.size()) {
+        throw std::invalid_argument(element);
+      }
+    } catch (const std::exception&) {
+      throw ParameterError(full_key, "'" + element + "' is not an index into a list");
+    }
+    if (position >= node.size()) {
+      throw ParameterError(full_key, "index " + element + " is past the end of the list");
+    }
+    if (last) {
+      node[position] = value;
+    } else {
+      setAtPath(node[position], path, index + 1, value, full_key);
+    }
+    return;
+  }
+  if (!node.IsMap() && !node.IsNull()) {
+    throw ParameterError(full_key, "'" + element + "' is below a value that is not a map");
+  }
+  if (last) {
+    node[element] = value;
+  } else {
+    setAtPath(node[element], path, index + 1, value, full_key);
+  }
+}
+
+void applyOverride(YAML::Node& root, const std::string& assignment) {
+  const std::size_t equals = assignment.find('=');
+  if (equals == std::string::npos || equals == 0) {
+    throw ParameterError(assignment, "an override reads key=value");
+  }
+  const std::string key = assignment.substr(0, equals);
+  std::vector<std::string> path;
+  std::stringstream stream(key);
+  for (std::string element; std::getline(stream, element, '.');) {
+    if (element.empty()) {
+      throw ParameterError(key, "has an empty path element");
+    }
+    path.push_back(element);
+  }
+  YAML::Node value;
+  try {
+    value = YAML::Load(assignment.substr(equals + 1));
+  } catch (const YAML::Exception& error) {
+    throw ParameterError(key, std::string("the value is not YAML: ") + error.what());
+  }
+  setAtPath(root, path, 0, value, key);
+}
+
+AgentModel readModel(detail::YamlReader& reader) {
+  detail::YamlReader model = reader.map("model");
+  const std::string type = model.string("type");
+  AgentModel result;
+  if (type == "double_integrator") {
+    result = makeDoubleIntegrator(model.integer("dimension"));
+  } else if (type == "linear") {
+    const Eigen::MatrixXd A = model.matrix("A", -1, -1);
+    result.A = A;
+    result.B = model.matrix("B", A.rows(), -1);
+    result.C = Eigen::MatrixXd::Identity(A.rows(), A.rows());
+    result.position_dimension = model.integer("position_dimension");
+  } else {
+    throw ParameterError(model.key("type"),
+                         "must be double_integrator or linear, got '" + type + "'");
+  }
+  if (model.has("C")) {
+    result.C = model.matrix("C", -1, result.A.rows());
+  }
+  model.finish();
+  validateAgentModel(result);
+  return result;
+}
+
+Eigen::MatrixXd readGain(detail::YamlReader& section, const AgentModel& model) {
+  const bool matrix_form = section.has("gain");
+  const bool pole_form = section.has("natural_frequency") || section.has("damping");
+  if (matrix_form && pole_form) {
+    throw ParameterError(section.key("gain"),
+                         "give either gain or natural_frequency/damping, not both");
+  }
+  if (!pole_form) {
+    return section.matrix("gain", model.inputDimension(), model.outputDimension());
+  }
+  if (!model.isDoubleIntegrator() ||
+      !model.C.isIdentity(0.0)) {
+    throw ParameterError(section.key("natural_frequency"),
+                         "needs a double_integrator model with C = identity; give gain instead");
+  }
+  const int axes = model.double_integrator_axes;
+  const Eigen::VectorXd omega = section.vectorOrScalar("natural_frequency", axes);
+  const Eigen::VectorXd zeta = section.vectorOrScalar("damping", axes);
+  return doubleIntegratorGain(omega, zeta, section.key("natural_frequency"));
+}
+
+ControllerParameters readController(detail::YamlReader& reader, const AgentModel& model) {
+  const Eigen::Index n = model.stateDimension();
+  const Eigen::Index m = model.inputDimension();
+  const Eigen::Index p = model.outputDimension();
+  detail::YamlReader controller = reader.map("controller");
+  ControllerParameters result;
+  result.model = model;
+  result.control_rate = controller.number("control_rate");
+  result.separation = controller.vector("separation");
+  result.alpha = controller.number("alpha");
+  result.epsilon = controller.number("epsilon");
+
+  detail::YamlReader baseline = controller.map("baseline");
+  result.baseline_gain = readGain(baseline, model);
+  baseline.finish();
+
+  detail::YamlReader estimator = controller.map("estimator");
+  result.estimator_gain = estimator.matrix("gain", n, p);
+  result.lyapunov_weight = estimator.matrix("lyapunov_weight", n, n);
+  if (estimator.has("substeps")) {
+    result.estimator_substeps = estimator.integer("substeps");
+  }
+  if (estimator.has("initial_estimate")) {
+    const std::string mode = estimator.string("initial_estimate");
+    if (mode == "measurement") {
+      result.initial_estimate = InitialEstimate::kMeasurement;
+    } else if (mode == "zero") {
+      result.initial_estimate = InitialEstimate::kZero;
+    } else {
+      throw ParameterError(estimator.key("initial_estimate"),
+                           "must be measurement or zero, got '" + mode + "'");
+    }
+  }
+  estimator.finish();
+
+  detail::YamlReader tracker = controller.map("tracker");
+  result.tracker_enabled = tracker.boolean("enabled");
+  result.tracker_gain = readGain(tracker, model);
+  result.reference_gain = tracker.has("reference_gain")
+                              ? tracker.matrix("reference_gain", m, p)
+                              : Eigen::MatrixXd::Zero(m, p);
+  tracker.finish();
+
+  if (controller.has("leader_information")) {
+    detail::YamlReader sharing = controller.map("leader_information");
+    if (sharing.has("command")) {
+      result.leader_input_in_command = sharing.boolean("command");
+    }
+    if (sharing.has("estimator")) {
+      result.leader_input_in_estimator = sharing.boolean("estimator");
+    }
+    sharing.finish();
+  }
+  controller.finish();
+  return result;
+}
+
+std::vector<Pulse> readPulses(detail::YamlReader& parent, const std::string& name) {
+  std::vector<Pulse> pulses;
+  const std::size_t count = parent.sequenceSize(name);
+  for (std::size_t i = 0; i < count; ++i) {
+    detail::YamlReader item = parent.item(name, i);
+    Pulse pulse;
+    pulse.start = item.number("start");
+    pulse.end = item.number("end");
+    pulse.vector = item.vector("vector");
+    item.finish();
+    pulses.push_back(pulse);
+  }
+  return pulses;
+}
+
+SignalProfile readInputProfile(detail::YamlReader& leader) {
+  SignalProfile profile;
+  if (!leader.has("input")) {
+    return profile;
+  }
+  detail::YamlReader input = leader.map("input");
+  if (input.has("pulses")) {
+    profile.pulses = readPulses(input, "pulses");
+  }
+  if (input.has("sinusoids")) {
+    const std::size_t count = input.sequenceSize("sinusoids");
+    for (std::size_t i = 0; i < count; ++i) {
+      detail::YamlReader item = input.item("sinusoids", i);
+      Sinusoid wave;
+      wave.amplitude = item.vector("amplitude");
+      wave.frequency = item.number("frequency");
+      wave.phase = item.has("phase") ? item.number("phase") : 0.0;
+      item.finish();
+      profile.sinusoids.push_back(wave);
+    }
+  }
+  input.finish();
+  return profile;
+}
+
+Scenario readScenario(const YAML::Node& root) {
+  detail::YamlReader reader(root, "");
+  Scenario scenario;
+  const AgentModel model = readModel(reader);
+  scenario.controller = readController(reader, model);
+
+  detail::YamlReader leader = reader.map("leader");
+  scenario.leader_initial_state = leader.vector("initial_state");
+  scenario.leader_input = readInputProfile(leader);
+  if (leader.has("disturbance")) {
+    scenario.disturbance.pulses = readPulses(leader, "disturbance");
+  }
+  leader.finish();
+
+  detail::YamlReader follower = reader.map("follower");
+  scenario.follower_initial_state = follower.vector("initial_state");
+  follower.finish();
+
+  detail::YamlReader simulation = reader.map("simulation");
+  scenario.duration = simulation.number("duration");
+  simulation.finish();
+  reader.finish();
+
+  ControllerDesign::create(scenario.controller);
+  scenario.validate();
+  return scenario;
+}
+
+Scenario parseRoot(YAML::Node root, const std::vector<std::string>& overrides) {
+  if (!root.IsMap()) {
+    throw ParameterError("(root)", "a scenario is a YAML map");
+  }
+  for (const std::string& assignment : overrides) {
+    applyOverride(root, assignment);
+  }
+  return readScenario(root);
+}
+
+}  // namespace
+
+Scenario parseScenario(const std::string& yaml_text, const std::vector<std::string>& overrides) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(yaml_text);
+  } catch (const YAML::Exception& error) {
+    throw ParameterError("(file)", std::string("not valid YAML: ") + error.what());
+  }
+  return parseRoot(root, overrides);
+}
+
+Scenario loadScenarioFile(const std::string& path, const std::vector<std::string>& overrides) {
+  std::ifstream file(path);
+  if (!file) {
+    throw ParameterError("(file)", "cannot read '" + path + "'");
+  }
+  std::stringstream text;
+  text << file.rdbuf();
+  return parseScenario(text.str(), overrides);
+}
+
+}  // namespace projection_collision_avoidance

@@ -1,0 +1,192 @@
+#pragma once
+
+/// @file
+/// Typed, key-tracking access to one YAML map of a scenario (internal to the scenario library).
+/// Every read marks its key as known; finish() refuses the keys nobody read.
+
+#include <yaml-cpp/yaml.h>
+
+#include <Eigen/Core>
+#include <set>
+#include <string>
+
+#include "projection_collision_avoidance/ParameterError.hpp"
+
+namespace projection_collision_avoidance {
+namespace detail {
+
+class YamlReader {
+ public:
+  /// @param node a YAML map
+  /// @param path dotted path of the map ("" for the root)
+  YamlReader(const YAML::Node& node, std::string path) : node_(node), path_(std::move(path)) {}
+
+  /// Dotted path of an entry of this map.
+  std::string key(const std::string& name) const {
+    return path_.empty() ? name : path_ + "." + name;
+  }
+
+  /// True when the entry is present and not null; a present key counts as known.
+  bool has(const std::string& name) {
+    const YAML::Node& node = node_;
+    if (!node[name]) {
+      return false;
+    }
+    used_.insert(name);
+    return !node[name].IsNull();
+  }
+
+  YamlReader map(const std::string& name) {
+    const YAML::Node child = required(name);
+    if (!child.IsMap()) {
+      throw ParameterError(key(name), "must be a map");
+    }
+    return YamlReader(child, key(name));
+  }
+
+  std::string string(const std::string& name) {
+    return scalar<std::string>(name, "a string");
+  }
+  double number(const std::string& name) { return scalar<double>(name, "a number"); }
+  bool boolean(const std::string& name) { return scalar<bool>(name, "true or false"); }
+
+  int integer(const std::string& name) {
+    const double value = number(name);
+    if (value != static_cast<double>(static_cast<int>(value))) {
+      throw ParameterError(key(name), "must be a whole number");
+    }
+    return static_cast<int>(value);
+  }
+
+  /// A list of numbers.
+  Eigen::VectorXd vector(const std::string& name) {
+    const YAML::Node child = required(name);
+    return toVector(child, key(name));
+  }
+
+  /// A list of @p size numbers, or one number repeated @p size times.
+  Eigen::VectorXd vectorOrScalar(const std::string& name, Eigen::Index size) {
+    const YAML::Node child = required(name);
+    if (child.IsScalar()) {
+      return Eigen::VectorXd::Constant(size, toNumber(child, key(name)));
+    }
+    return toVector(child, key(name));
+  }
+
+  /// A list of rows, or a number s meaning s * I. rows/cols < 0 mean "not known here"; a number
+  /// needs the matrix to be square with a known size.
+  Eigen::MatrixXd matrix(const std::string& name, Eigen::Index rows, Eigen::Index cols) {
+    const YAML::Node child = required(name);
+    if (child.IsScalar()) {
+      const double value = toNumber(child, key(name));
+      const Eigen::Index size = rows >= 0 ? rows : cols;
+      if (size < 0 || (rows >= 0 && cols >= 0 && rows != cols)) {
+        throw ParameterError(key(name), "a number stands for s * I and needs a square matrix "
+                                        "of known size; give a list of rows");
+      }
+      return value * Eigen::MatrixXd::Identity(size, size);
+    }
+    if (!child.IsSequence() || child.size() == 0) {
+      throw ParameterError(key(name), "must be a list of rows or a number");
+    }
+    const Eigen::Index row_count = static_cast<Eigen::Index>(child.size());
+    Eigen::MatrixXd result;
+    for (Eigen::Index i = 0; i < row_count; ++i) {
+      const YAML::Node row = child[static_cast<std::size_t>(i)];
+      if (!row.IsSequence()) {
+        throw ParameterError(key(name), "must be a list of rows, e.g. [[1.0, 1.4]]");
+      }
+      const Eigen::VectorXd values = toVector(row, key(name) + "." + std::to_string(i));
+      if (i == 0) {
+        result.resize(row_count, values.size());
+      } else if (values.size() != result.cols()) {
+        throw ParameterError(key(name), "rows have different lengths");
+      }
+      result.row(i) = values.transpose();
+    }
+    return result;
+  }
+
+  /// Number of items of a list (the key is then known).
+  std::size_t sequenceSize(const std::string& name) {
+    const YAML::Node child = required(name);
+    if (!child.IsSequence()) {
+      throw ParameterError(key(name), "must be a list");
+    }
+    return child.size();
+  }
+
+  /// Item @p index of a list of maps.
+  YamlReader item(const std::string& name, std::size_t index) {
+    const YAML::Node child = required(name)[index];
+    const std::string item_key = key(name) + "." + std::to_string(index);
+    if (!child.IsMap()) {
+      throw ParameterError(item_key, "must be a map");
+    }
+    return YamlReader(child, item_key);
+  }
+
+  /// Refuses every key of this map that was not read.
+  void finish() const {
+    for (const auto& entry : node_) {
+      const std::string name = entry.first.as<std::string>();
+      if (used_.count(name) == 0) {
+        throw ParameterError(key(name), "unknown key");
+      }
+    }
+  }
+
+ private:
+  YAML::Node required(const std::string& name) {
+    const YAML::Node& node = node_;
+    const YAML::Node child = node[name];
+    if (!child || child.IsNull()) {
+      throw ParameterError(key(name), "missing");
+    }
+    used_.insert(name);
+    return child;
+  }
+
+  template <typename T>
+  T scalar(const std::string& name, const char* what) {
+    const YAML::Node child = required(name);
+    if (!child.IsScalar()) {
+      throw ParameterError(key(name), std::string("must be ") + what);
+    }
+    try {
+      return child.as<T>();
+    } catch (const YAML::Exception&) {
+      throw ParameterError(key(name),
+                           std::string("must be ") + what + ", got '" + child.Scalar() + "'");
+    }
+  }
+
+  static double toNumber(const YAML::Node& node, const std::string& key) {
+    try {
+      return node.as<double>();
+    } catch (const YAML::Exception&) {
+      throw ParameterError(key, "must be a number, got '" + node.Scalar() + "'");
+    }
+  }
+
+  static Eigen::VectorXd toVector(const YAML::Node& node, const std::string& key) {
+    if (!node.IsSequence()) {
+      throw ParameterError(key, "must be a list of numbers");
+    }
+    Eigen::VectorXd result(static_cast<Eigen::Index>(node.size()));
+    for (std::size_t i = 0; i < node.size(); ++i) {
+      if (!node[i].IsScalar()) {
+        throw ParameterError(key, "must be a list of numbers");
+      }
+      result(static_cast<Eigen::Index>(i)) = toNumber(node[i], key);
+    }
+    return result;
+  }
+
+  YAML::Node node_;
+  std::string path_;
+  std::set<std::string> used_;
+};
+
+}  // namespace detail
+}  // namespace projection_collision_avoidance

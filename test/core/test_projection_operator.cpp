@@ -1,0 +1,219 @@
+/// Properties of the Gamma-weighted projection operator (doc/math.md) against the literal
+/// reading of the paper's eqs. (12)/(15), and the invariance of Omega_1 under the discretised
+/// estimator.
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "EigenTestHelpers.hpp"
+#include "projection_collision_avoidance/BallConstraint.hpp"
+#include "projection_collision_avoidance/CollisionFreeEstimator.hpp"
+#include "projection_collision_avoidance/ControllerDesign.hpp"
+#include "projection_collision_avoidance/ProjectionOperator.hpp"
+
+namespace projection_collision_avoidance {
+namespace {
+
+using testing::randomOnSphere;
+using testing::randomSpd;
+using testing::randomVector;
+
+constexpr double kXiMax = 4.0;
+constexpr double kEpsilon = 0.2;
+
+/// The paper's text taken literally: Gamma^-1 Proj(xi_hat, Gamma h) with the unweighted
+/// operator (7) (condition on the field, as Lavretsky & Wise have it).
+Eigen::VectorXd literalPaperDrift(const BallConstraint& c, const Eigen::VectorXd& x,
+                                  const Eigen::VectorXd& h, const Eigen::MatrixXd& gamma) {
+  const Eigen::VectorXd g = gamma * h;
+  const Eigen::VectorXd grad = c.gradient(x);
+  const double f = c.value(x);
+  Eigen::VectorXd projected = g;
+  if (f > 0.0 && grad.dot(g) > 0.0) {
+    projected = g - f * grad * grad.dot(g) / grad.squaredNorm();
+  }
+  return gamma.inverse() * projected;
+}
+
+// Points on and beyond the boundary (f >= 1): the projected field never points outward.
+TEST(ProjectionOperator, NeverPointsOutwardOnOrBeyondTheBoundary) {
+  std::mt19937 rng(1);
+  const BallConstraint ball(kXiMax, kEpsilon);
+  std::uniform_real_distribution<double> beyond(1.0, 1.5);
+  int active = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    const int n = 1 + trial % 6;
+    const Eigen::MatrixXd gamma = randomSpd(rng, n, 0.01, 100.0);
+    const Eigen::MatrixXd gamma_inverse = gamma.inverse();
+    const double radius = (trial % 2 == 0) ? kXiMax : kXiMax * beyond(rng);
+    const Eigen::VectorXd x = randomOnSphere(rng, n, radius);
+    const Eigen::VectorXd h = randomVector(rng, n, 10.0);
+    ASSERT_GE(ball.value(x), 1.0 - 1e-12);
+    bool was_active = false;
+    const Eigen::VectorXd rate = projectDrift(ball, x, h, gamma_inverse, &was_active);
+    active += was_active ? 1 : 0;
+    const double outward = ball.gradient(x).dot(rate);
+    // On the sphere the outward rate is zero up to rounding; beyond it, strictly inward.
+    ASSERT_LE(outward, 1e-9 * ball.gradient(x).norm() * h.norm())
+        << "n=" << n << " f=" << ball.value(x) << "\nGamma=\n" << gamma << "\nx=" << x.transpose()
+        << "\nh=" << h.transpose();
+  }
+  EXPECT_GT(active, 5000);  // the test exercised the projection, not only the pass-through
+}
+
+// Theorem 3.1's inequality (xi_hat - xi)^T Gamma (xi_hat' - h) <= 0 for xi inside Omega_1 and
+// xi_hat on or beyond the boundary.
+TEST(ProjectionOperator, LyapunovInequalityForXiInsideTheHardBound) {
+  std::mt19937 rng(2);
+  const BallConstraint ball(kXiMax, kEpsilon);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (int trial = 0; trial < 20000; ++trial) {
+    const int n = 1 + trial % 6;
+    const Eigen::MatrixXd gamma = randomSpd(rng, n, 0.01, 100.0);
+    const Eigen::VectorXd x = randomOnSphere(rng, n, kXiMax * (1.0 + 0.5 * unit(rng)));
+    const Eigen::VectorXd xi = randomOnSphere(rng, n, kXiMax * unit(rng));
+    const Eigen::VectorXd h = randomVector(rng, n, 10.0);
+    const Eigen::VectorXd rate = projectDrift(ball, x, h, Eigen::MatrixXd(gamma.inverse()), nullptr);
+    const double value = (x - xi).dot(gamma * (rate - h));
+    ASSERT_LE(value, 1e-9 * (1.0 + gamma.norm() * h.norm() * x.norm()));
+  }
+}
+
+// Inside the soft band (0 < f < 1) the inequality holds for every xi in Omega_0 (Lavretsky &
+// Wise's hypothesis), and more generally whenever ||xi|| <= ||xi_hat||.
+TEST(ProjectionOperator, LyapunovInequalityInTheBandForXiInsideTheSoftBound) {
+  std::mt19937 rng(3);
+  const BallConstraint ball(kXiMax, kEpsilon);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (int trial = 0; trial < 20000; ++trial) {
+    const int n = 1 + trial % 6;
+    const Eigen::MatrixXd gamma = randomSpd(rng, n, 0.01, 100.0);
+    const double r = ball.softRadius() + (kXiMax - ball.softRadius()) * unit(rng);
+    const Eigen::VectorXd x = randomOnSphere(rng, n, r);
+    const Eigen::VectorXd xi = randomOnSphere(rng, n, r * unit(rng));
+    const Eigen::VectorXd h = randomVector(rng, n, 10.0);
+    const Eigen::VectorXd rate = projectDrift(ball, x, h, Eigen::MatrixXd(gamma.inverse()), nullptr);
+    ASSERT_LE((x - xi).dot(gamma * (rate - h)), 1e-9 * (1.0 + gamma.norm() * h.norm() * x.norm()));
+  }
+}
+
+// ... but not for every xi in Omega_1: with xi_hat in the band and xi farther out along the same
+// direction, the removed term has the wrong sign. Theorem 3.1 therefore needs xi in Omega_0 (or
+// ||xi|| <= ||xi_hat||) while the projection acts; the test pins this down.
+TEST(ProjectionOperator, LyapunovInequalityCanFailInTheBandForXiBetweenTheBounds) {
+  const BallConstraint ball(kXiMax, kEpsilon);
+  const Eigen::MatrixXd gamma = Eigen::MatrixXd::Identity(2, 2);
+  const Eigen::VectorXd x = Eigen::Vector2d(3.9, 0.0);   // 0 < f < 1
+  const Eigen::VectorXd xi = Eigen::Vector2d(4.0, 0.0);  // on the hard bound
+  const Eigen::VectorXd h = Eigen::Vector2d(1.0, 0.0);   // pointing outward
+  ASSERT_GT(ball.value(x), 0.0);
+  ASSERT_LT(ball.value(x), 1.0);
+  const Eigen::VectorXd rate = projectDrift(ball, x, h, gamma, nullptr);
+  EXPECT_GT((x - xi).dot(gamma * (rate - h)), 0.0);
+}
+
+// The literal Gamma^-1 Proj(xi_hat, Gamma h) lets the field point out of Omega_1 on its
+// boundary when Gamma is not a multiple of I: it fails the first property.
+TEST(ProjectionOperator, LiteralPaperFormPointsOutwardOnTheBoundary) {
+  std::mt19937 rng(4);
+  const BallConstraint ball(kXiMax, kEpsilon);
+  int outward_cases = 0;
+  double worst = 0.0;
+  for (int trial = 0; trial < 2000; ++trial) {
+    const Eigen::MatrixXd gamma = randomSpd(rng, 2, 0.1, 10.0);
+    const Eigen::VectorXd x = randomOnSphere(rng, 2, kXiMax);
+    const Eigen::VectorXd h = randomVector(rng, 2, 10.0);
+    const Eigen::VectorXd rate = literalPaperDrift(ball, x, h, gamma);
+    const double outward = ball.gradient(x).dot(rate) / ball.gradient(x).norm();
+    if (outward > 1e-6) {
+      ++outward_cases;
+    }
+    worst = std::max(worst, outward);
+  }
+  EXPECT_GT(outward_cases, 100) << "largest outward rate " << worst << " m/s";
+}
+
+// With Gamma = c I the literal form and the weighted form agree.
+TEST(ProjectionOperator, LiteralAndWeightedFormsAgreeForScalarGamma) {
+  std::mt19937 rng(5);
+  const BallConstraint ball(kXiMax, kEpsilon);
+  for (int trial = 0; trial < 500; ++trial) {
+    const Eigen::MatrixXd gamma = 3.7 * Eigen::MatrixXd::Identity(3, 3);
+    const Eigen::VectorXd x = randomOnSphere(rng, 3, kXiMax * (0.9 + 0.2 * (trial % 3)));
+    const Eigen::VectorXd h = randomVector(rng, 3, 10.0);
+    EXPECT_MATRIX_NEAR(projectDrift(ball, x, h, Eigen::MatrixXd(gamma.inverse()), nullptr),
+                       literalPaperDrift(ball, x, h, gamma), 1e-10);
+  }
+}
+
+TEST(ProjectionOperator, PassesTheDriftThroughInsideTheSoftBound) {
+  const BallConstraint ball(kXiMax, kEpsilon);
+  const Eigen::VectorXd x = Eigen::Vector2d(1.0, 2.0);
+  const Eigen::VectorXd h = Eigen::Vector2d(5.0, 7.0);
+  bool active = false;
+  EXPECT_MATRIX_NEAR(projectDrift(ball, x, h, Eigen::MatrixXd(Eigen::Matrix2d::Identity()), &active),
+                     h, 0.0);
+  EXPECT_FALSE(active);
+}
+
+TEST(BallConstraint, LevelSetsAreTheSoftAndHardBalls) {
+  const BallConstraint ball(kXiMax, kEpsilon);
+  EXPECT_NEAR(ball.value(Eigen::Vector2d(kXiMax, 0.0)), 1.0, 1e-12);
+  EXPECT_NEAR(ball.value(Eigen::Vector2d(0.0, ball.softRadius())), 0.0, 1e-12);
+  EXPECT_NEAR(ball.softRadius(), kXiMax / std::sqrt(1.0 + kEpsilon), 1e-12);
+  // Gradient by central differences.
+  const Eigen::Vector3d x(1.0, -2.0, 0.5);
+  const Eigen::Vector3d g = ball.gradient(x);
+  for (int i = 0; i < 3; ++i) {
+    Eigen::Vector3d step = Eigen::Vector3d::Zero();
+    step(i) = 1e-6;
+    EXPECT_NEAR(g(i), (ball.value(x + step) - ball.value(x - step)) / 2e-6, 1e-6);
+  }
+}
+
+/// A design with a strongly non-normal A_c + L C (so Gamma is far from c I).
+ControllerDesign skewedDesign(int substeps) {
+  ControllerParameters p;
+  p.model = makeDoubleIntegrator(1);
+  p.control_rate = 100.0;
+  p.separation = Eigen::Vector2d(5.0, 0.0);
+  p.alpha = 0.2;
+  p.epsilon = 0.2;
+  p.baseline_gain = Eigen::RowVector2d(1.0, 1.4);
+  p.estimator_gain = (Eigen::Matrix2d() << -5.0, 3.0, -8.0, -2.0).finished();
+  p.lyapunov_weight = (Eigen::Matrix2d() << 1.0, 0.3, 0.3, 4.0).finished();
+  p.estimator_substeps = substeps;
+  p.tracker_enabled = true;
+  p.tracker_gain = Eigen::RowVector2d(10.0, 5.0);
+  p.reference_gain = Eigen::RowVector2d::Zero();
+  return ControllerDesign::create(p);
+}
+
+// The discretised estimator keeps ||xi_hat|| <= xi_max after every period, for measurements far
+// outside the bound, and the boundary safeguard removes only RK4's truncation error.
+TEST(CollisionFreeEstimator, DiscretisationKeepsTheHardBound) {
+  std::mt19937 rng(6);
+  for (const int substeps : {1, 4}) {
+    const ControllerDesign design = skewedDesign(substeps);
+    ASSERT_GT((design.gamma - design.gamma(0, 0) * Eigen::Matrix2d::Identity()).norm(), 0.1);
+    CollisionFreeEstimator<DoubleIntegrator1D> estimator(design);
+    estimator.reset(Eigen::Vector2d(0.0, design.xi_max));
+    double largest_correction = 0.0;
+    int active_periods = 0;
+    for (int k = 0; k < 20000; ++k) {
+      const Eigen::Vector2d y = randomOnSphere(rng, 2, design.xi_max * 3.0);
+      const Eigen::Matrix<double, 1, 1> u_a = randomVector(rng, 1, 20.0);
+      const EstimatorPeriodReport report =
+          estimator.advance(y, u_a, Eigen::Vector2d::Zero(), design.period, substeps);
+      ASSERT_LE(estimator.estimate().norm(), design.xi_max) << "period " << k;
+      largest_correction = std::max(largest_correction, report.boundary_correction);
+      active_periods += report.projection_active ? 1 : 0;
+    }
+    EXPECT_GT(active_periods, 1000);
+    EXPECT_LT(largest_correction, 1e-6 * design.xi_max) << "substeps " << substeps;
+  }
+}
+
+}  // namespace
+}  // namespace projection_collision_avoidance
