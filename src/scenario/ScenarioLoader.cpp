@@ -43,9 +43,12 @@ void setAtPath(YAML::Node node, const std::vector<std::string>& path, std::size_
   }
   if (last) {
     node[element] = value;
-  } else {
-    setAtPath(node[element], path, index + 1, value, full_key);
+    return;
   }
+  if (!node[element].IsDefined() || node[element].IsNull()) {
+    node[element] = YAML::Node(YAML::NodeType::Map);  // create the missing level
+  }
+  setAtPath(node[element], path, index + 1, value, full_key);
 }
 
 void applyOverride(YAML::Node& root, const std::string& assignment) {

@@ -73,12 +73,15 @@ class YamlReader {
     return toVector(child, key(name));
   }
 
-  /// A list of rows, or a number s meaning s * I. rows/cols < 0 mean "not known here"; a number
-  /// needs the matrix to be square with a known size.
+  /// A list of rows, or a number s meaning s * I (0 meaning the zero matrix of any shape).
+  /// rows/cols < 0 mean "not known here"; a number needs the size to be known.
   Eigen::MatrixXd matrix(const std::string& name, Eigen::Index rows, Eigen::Index cols) {
     const YAML::Node child = required(name);
     if (child.IsScalar()) {
       const double value = toNumber(child, key(name));
+      if (value == 0.0 && rows >= 0 && cols >= 0) {
+        return Eigen::MatrixXd::Zero(rows, cols);
+      }
       const Eigen::Index size = rows >= 0 ? rows : cols;
       if (size < 0 || (rows >= 0 && cols >= 0 && rows != cols)) {
         throw ParameterError(key(name), "a number stands for s * I and needs a square matrix "

@@ -76,13 +76,16 @@ def _rotated_2d(angle_deg):
         "follower.initial_state=[0.0, 0.0, 0.0, 0.0]",
         f"leader.disturbance.0.vector={vec(-2.0, -2.0)}",
         "controller.tracker.gain=[[10.0, 0.0, 5.0, 0.0], [0.0, 10.0, 0.0, 5.0]]",
-        "controller.tracker.reference_gain=0",
+        "controller.tracker.reference_gain=[[0.0, 0.0, 0.0, 0.0], [0.0, 0.0, 0.0, 0.0]]",
     )
 
 
 _LEADER_INPUT = ("leader.input={pulses: [{start: 5.0, end: 9.0, vector: [0.8]}], "
                  "sinusoids: [{amplitude: [0.6], frequency: 0.05, phase: 0.5}]}")
 
+# The overrides set whole mappings and spell matrices out in full, so that
+# they do not depend on how a tool treats a --set below a key that the file
+# lacks, or a plain number for a non-square matrix.
 CASES = (
     Case("paper_run1", "paper_run1.yaml", note="tracker off, leaves the bound"),
     Case("paper_run2", "paper_run2.yaml", note="tracker on"),
@@ -110,7 +113,7 @@ CASES = (
           "leader.disturbance.0.vector=[-3.0, -3.5]"),
          note="tracker on, beyond the paper's safe disturbance size"),
     Case("leader_input_shared", "paper_run2.yaml",
-         (_LEADER_INPUT, "controller.leader_information.estimator=true"),
+         (_LEADER_INPUT, "controller.leader_information={command: false, estimator: true}"),
          note="leader input u_1 told to the estimator, not fed forward"),
     Case("leader_input_unshared", "paper_run2.yaml", (_LEADER_INPUT,),
          note="leader input u_1 unknown to the follower"),
@@ -214,6 +217,8 @@ def parse_args(argv):
                     help="run only this case (repeatable); see --list")
     ap.add_argument("--jobs", type=int, default=max(1, (os.cpu_count() or 2) // 2),
                     help="cases run in parallel (each runs both tools at once)")
+    ap.add_argument("--xunit", metavar="FILE",
+                    help="also write the results as a JUnit XML file")
     ap.add_argument("--list", action="store_true", help="list the cases and exit")
     return ap.parse_args(argv)
 
@@ -242,13 +247,32 @@ def main(argv=None):
                                args.scenarios_dir, args.tolerance,
                                args.cf_sim_arg, args.reference_arg) for c in cases]
         passed = failed = 0
-        for future in futures:                    # report in case order
+        results = []
+        for case, future in zip(cases, futures):  # report in case order
             ok, line = future.result()
             print(line, flush=True)
+            results.append((case.name, ok, line))
             passed += ok
             failed += not ok
     print(f"{passed} passed, {failed} failed")
+    if args.xunit:
+        write_xunit(args.xunit, results)
     return 1 if failed else 0
+
+
+def write_xunit(path, results):
+    """Writes the cases as a JUnit XML file (read by catkin_test_results)."""
+    import xml.etree.ElementTree as ET
+    suite = ET.Element("testsuite", name="compare_with_reference", tests=str(len(results)),
+                       failures=str(sum(1 for _, ok, _ in results if not ok)), errors="0")
+    for name, ok, line in results:
+        case = ET.SubElement(suite, "testcase", classname="compare_with_reference", name=name)
+        if not ok:
+            ET.SubElement(case, "failure", message=line).text = line
+        else:
+            ET.SubElement(case, "system-out").text = line
+    os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
+    ET.ElementTree(suite).write(path, encoding="utf-8", xml_declaration=True)
 
 
 if __name__ == "__main__":
