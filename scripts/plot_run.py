@@ -19,7 +19,7 @@ Several runs are drawn side by side, with a common y range per row when the
 runs have the same layout, so e.g. Run 1 and Run 2 compare at a glance.
 
 The input is the CSV of ``cf_sim --csv`` / ``reference_sim.py --csv``
-(doc/scenario_format.md). Loading is done by load_run(), which dispatches on
+(README.md, section 'Scenario files'). Loading is done by load_run(), which dispatches on
 the file name to a loader returning a dict of column name -> numpy array; a
 loader for other recordings (e.g. a rosbag) only has to return the same dict.
 """
@@ -66,7 +66,7 @@ def load_csv(path):
 
 
 # File-name suffix -> loader. Each loader returns {column: np.ndarray}
-# with the column names of doc/scenario_format.md.
+# with the column names of README.md, section 'Scenario files'.
 LOADERS = {".csv": load_csv}
 
 REQUIRED = ("t", "xi_0", "xi_hat_0", "norm_xi", "norm_xi_hat", "xi_max", "xi_soft",
