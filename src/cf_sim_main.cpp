@@ -8,6 +8,8 @@
 #include "projection_collision_avoidance/CfSimApp.hpp"
 
 int main(int argc, char** argv) {
+  // argv/argc is the C interface of main(); this is the one place it is turned into a range.
+  // NOLINTNEXTLINE(cppcoreguidelines-pro-bounds-pointer-arithmetic)
   const std::vector<std::string> arguments(argv + 1, argv + argc);
   return projection_collision_avoidance::runCfSim(arguments, std::cout, std::cerr);
 }

@@ -1,17 +1,18 @@
 #pragma once
 
-#include <Eigen/Core>
 #include <string>
+
+#include <Eigen/Core>
 
 namespace projection_collision_avoidance {
 
 /// The LTI model shared by the leader and the follower (paper, eq. (1)):
 /// x' = A x + B u, y = C x, with the leading position_dimension entries of x being positions.
 struct AgentModel {
-  Eigen::MatrixXd A;            ///< n x n state matrix
-  Eigen::MatrixXd B;            ///< n x m input matrix
-  Eigen::MatrixXd C;            ///< p x n output matrix (relative measurement y = C xi)
-  int position_dimension = 0;   ///< number of leading state entries that are positions (m)
+  Eigen::MatrixXd A;               ///< n x n state matrix
+  Eigen::MatrixXd B;               ///< n x m input matrix
+  Eigen::MatrixXd C;               ///< p x n output matrix (relative measurement y = C xi)
+  int position_dimension = 0;      ///< number of leading state entries that are positions (m)
   int double_integrator_axes = 0;  ///< k > 0 when the model is a k-axis double integrator
 
   int stateDimension() const { return static_cast<int>(A.rows()); }

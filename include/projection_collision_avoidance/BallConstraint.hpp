@@ -1,7 +1,8 @@
 #pragma once
 
-#include <Eigen/Core>
 #include <cmath>
+
+#include <Eigen/Core>
 
 namespace projection_collision_avoidance {
 

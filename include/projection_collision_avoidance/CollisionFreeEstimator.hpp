@@ -1,5 +1,6 @@
 #pragma once
 
+#include <algorithm>
 #include <stdexcept>
 
 #include "projection_collision_avoidance/BallConstraint.hpp"
@@ -11,9 +12,9 @@ namespace projection_collision_avoidance {
 
 /// What happened to the estimate over one control period.
 struct EstimatorPeriodReport {
-  bool projection_active = false;   ///< the projection changed the drift in some substep
-  double boundary_correction = 0.0; ///< largest distance (m) by which a substep's result was
-                                    ///< moved back onto the sphere ||xi_hat|| = xi_max
+  bool projection_active = false;    ///< the projection changed the drift in some substep
+  double boundary_correction = 0.0;  ///< largest distance (m) by which a substep's result was
+                                     ///< moved back onto the sphere ||xi_hat|| = xi_max
 };
 
 /// The collision-free (CF) estimator: a Luenberger observer of the relative error xi whose drift
@@ -42,8 +43,8 @@ class CollisionFreeEstimator {
     const Eigen::Index p = design.parameters.model.outputDimension();
     if ((Dims::kStates != Eigen::Dynamic && Dims::kStates != n) ||
         (Dims::kInputs != Eigen::Dynamic && Dims::kInputs != m) ||
-        (Dims::kOutputs != Eigen::Dynamic && Dims::kOutputs != p) ||
-        n > Dims::kMaxStates || m > Dims::kMaxInputs || p > Dims::kMaxOutputs) {
+        (Dims::kOutputs != Eigen::Dynamic && Dims::kOutputs != p) || n > Dims::kMaxStates ||
+        m > Dims::kMaxInputs || p > Dims::kMaxOutputs) {
       throw std::invalid_argument("CollisionFreeEstimator: model sizes do not fit the dimensions");
     }
     estimator_matrix_ = design.estimator_matrix;
@@ -121,10 +122,10 @@ class CollisionFreeEstimator {
   }
 
   BallConstraint constraint_;
-  StateMatrix estimator_matrix_;     // A_c + L C
-  InputMatrix input_matrix_;         // B
-  ObserverGainMatrix observer_gain_; // L
-  StateMatrix gamma_inverse_;        // Gamma^-1
+  StateMatrix estimator_matrix_;      // A_c + L C
+  InputMatrix input_matrix_;          // B
+  ObserverGainMatrix observer_gain_;  // L
+  StateMatrix gamma_inverse_;         // Gamma^-1
   StateVector estimate_;
 };
 

@@ -11,16 +11,16 @@ namespace projection_collision_avoidance {
 /// cover, naming the offending key.
 struct ControllerDesign {
   ControllerParameters parameters;
-  double period = 0.0;            ///< control period T = 1 / control_rate (s)
-  double xi_max = 0.0;            ///< hard bound (1 - alpha) ||d|| (4) (m)
-  double xi_soft = 0.0;           ///< soft bound xi_max / sqrt(1 + epsilon) (14a) (m)
-  double perimeter = 0.0;         ///< safety perimeter alpha ||d|| (m)
-  Eigen::MatrixXd closed_loop;    ///< A_c = A - B G C (3)
-  Eigen::MatrixXd estimator_matrix;  ///< A_c + L C (11)
-  Eigen::MatrixXd tracking_matrix;   ///< A_c - B G_e C (26a)
-  Eigen::MatrixXd gamma;          ///< Gamma: Gamma (A_c + L C) + (A_c + L C)^T Gamma = -Q
-  Eigen::MatrixXd gamma_inverse;  ///< Gamma^-1
-  double lyapunov_residual = 0.0; ///< ||Gamma F + F^T Gamma + Q||_F / ||Q||_F
+  double period = 0.0;                   ///< control period T = 1 / control_rate (s)
+  double xi_max = 0.0;                   ///< hard bound (1 - alpha) ||d|| (4) (m)
+  double xi_soft = 0.0;                  ///< soft bound xi_max / sqrt(1 + epsilon) (14a) (m)
+  double perimeter = 0.0;                ///< safety perimeter alpha ||d|| (m)
+  Eigen::MatrixXd closed_loop;           ///< A_c = A - B G C (3)
+  Eigen::MatrixXd estimator_matrix;      ///< A_c + L C (11)
+  Eigen::MatrixXd tracking_matrix;       ///< A_c - B G_e C (26a)
+  Eigen::MatrixXd gamma;                 ///< Gamma: Gamma (A_c + L C) + (A_c + L C)^T Gamma = -Q
+  Eigen::MatrixXd gamma_inverse;         ///< Gamma^-1
+  double lyapunov_residual = 0.0;        ///< ||Gamma F + F^T Gamma + Q||_F / ||Q||_F
   Eigen::MatrixXd output_pseudoinverse;  ///< pinv(C), n x p, for the initial estimate
   /// Decay rate mu = lambda_min(Q) / (2 lambda_max(Gamma)) of Theorem 3.1: ||e(t)|| <=
   /// K_0 e^{-mu t / 2} ||e(0)|| with K_0 = sqrt(lambda_max(Gamma) / lambda_min(Gamma)).

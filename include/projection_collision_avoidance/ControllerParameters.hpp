@@ -1,5 +1,7 @@
 #pragma once
 
+#include <string>
+
 #include <Eigen/Core>
 
 #include "projection_collision_avoidance/AgentModel.hpp"
@@ -15,19 +17,19 @@ enum class InitialEstimate {
 /// Everything the follower's controller needs, as read from configuration. Validate and derive
 /// with ControllerDesign::create(); nothing here is trusted before that.
 struct ControllerParameters {
-  AgentModel model;                  ///< the agents' (A, B, C)
-  double control_rate = 0.0;         ///< Hz
-  Eigen::VectorXd separation;        ///< d in ker(A), n (m, and zero velocity)
-  double alpha = 0.0;                ///< perimeter fraction, [0, 1)
-  double epsilon = 0.0;              ///< soft-boundary width of the projection, > 0
-  Eigen::MatrixXd baseline_gain;     ///< G, m x p (2)
-  Eigen::MatrixXd estimator_gain;    ///< L, n x p (11)
-  Eigen::MatrixXd lyapunov_weight;   ///< Q, n x n, symmetric positive definite
-  int estimator_substeps = 1;        ///< RK4 steps of the estimator per control period
+  AgentModel model;                 ///< the agents' (A, B, C)
+  double control_rate = 0.0;        ///< Hz
+  Eigen::VectorXd separation;       ///< d in ker(A), n (m, and zero velocity)
+  double alpha = 0.0;               ///< perimeter fraction, [0, 1)
+  double epsilon = 0.0;             ///< soft-boundary width of the projection, > 0
+  Eigen::MatrixXd baseline_gain;    ///< G, m x p (2)
+  Eigen::MatrixXd estimator_gain;   ///< L, n x p (11)
+  Eigen::MatrixXd lyapunov_weight;  ///< Q, n x n, symmetric positive definite
+  int estimator_substeps = 1;       ///< RK4 steps of the estimator per control period
   InitialEstimate initial_estimate = InitialEstimate::kMeasurement;
-  bool tracker_enabled = true;       ///< CF tracker (19) on or off
-  Eigen::MatrixXd tracker_gain;      ///< G_e, m x p (19)
-  Eigen::MatrixXd reference_gain;    ///< S_21, m x p (19)
+  bool tracker_enabled = true;             ///< CF tracker (19) on or off
+  Eigen::MatrixXd tracker_gain;            ///< G_e, m x p (19)
+  Eigen::MatrixXd reference_gain;          ///< S_21, m x p (19)
   bool leader_input_in_command = false;    ///< add the leader's input u_1 to the command
   bool leader_input_in_estimator = false;  ///< model B (u_1 - u_ff) in the estimator drift
 };

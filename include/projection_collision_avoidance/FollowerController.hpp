@@ -10,15 +10,15 @@ namespace projection_collision_avoidance {
 /// Everything the follower computed at one control tick.
 template <typename Dims>
 struct FollowerStatus {
-  typename Dims::InputVector command;           ///< u_2 = baseline + tracker + feed-forward
-  typename Dims::InputVector baseline_command;  ///< G y (2)
-  typename Dims::InputVector tracker_command;   ///< u_a (19)
+  typename Dims::InputVector command;              ///< u_2 = baseline + tracker + feed-forward
+  typename Dims::InputVector baseline_command;     ///< G y (2)
+  typename Dims::InputVector tracker_command;      ///< u_a (19)
   typename Dims::InputVector feedforward_command;  ///< u_1 when shared into the command, else 0
-  typename Dims::StateVector estimate;          ///< xi_hat used at this tick (m)
-  double estimate_norm = 0.0;                   ///< ||xi_hat|| (m)
-  double constraint_value = 0.0;                ///< f(xi_hat) (13)
-  bool projection_active = false;   ///< the projection acted during the period that follows
-  double boundary_correction = 0.0; ///< see EstimatorPeriodReport (m)
+  typename Dims::StateVector estimate;             ///< xi_hat used at this tick (m)
+  double estimate_norm = 0.0;                      ///< ||xi_hat|| (m)
+  double constraint_value = 0.0;                   ///< f(xi_hat) (13)
+  bool projection_active = false;    ///< the projection acted during the period that follows
+  double boundary_correction = 0.0;  ///< see EstimatorPeriodReport (m)
 };
 
 /// The follower's controller: baseline law (2) augmented (10) by the CF tracker (19), which
@@ -110,8 +110,8 @@ class FollowerController {
     if (leader_input_known && p.leader_input_in_estimator) {
       known_drift = input_matrix_ * (leader_input - status_.feedforward_command);
     }
-    const EstimatorPeriodReport report = estimator_.advance(
-        y, status_.tracker_command, known_drift, design_.period, p.estimator_substeps);
+    const EstimatorPeriodReport report = estimator_.advance(y, status_.tracker_command, known_drift,
+                                                            design_.period, p.estimator_substeps);
     status_.projection_active = report.projection_active;
     status_.boundary_correction = report.boundary_correction;
     return status_;
@@ -120,9 +120,9 @@ class FollowerController {
   ControllerDesign design_;
   CollisionFreeEstimator<Dims> estimator_;
   CollisionFreeTracker<Dims> tracker_;
-  typename Dims::InputMatrix input_matrix_;              // B
-  typename Dims::OutputMatrix output_matrix_;            // C
-  typename Dims::FeedbackGainMatrix baseline_gain_;      // G
+  typename Dims::InputMatrix input_matrix_;                 // B
+  typename Dims::OutputMatrix output_matrix_;               // C
+  typename Dims::FeedbackGainMatrix baseline_gain_;         // G
   typename Dims::ObserverGainMatrix output_pseudoinverse_;  // pinv(C)
   FollowerStatus<Dims> status_;
   bool initialized_ = false;

@@ -3,8 +3,9 @@
 /// @file
 /// Linear-algebra checks used when parameters load (never in a control step).
 
-#include <Eigen/Core>
 #include <string>
+
+#include <Eigen/Core>
 
 namespace projection_collision_avoidance {
 

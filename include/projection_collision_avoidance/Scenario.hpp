@@ -9,7 +9,7 @@ namespace projection_collision_avoidance {
 
 /// A leader-follower run: the follower's controller parameters, both agents' initial states,
 /// the leader's input and disturbance, and the duration. Loaded from the YAML format of
-/// doc/scenario_format.md by loadScenario() (scenario library).
+/// README.md, "Scenario files" by loadScenarioFile() (scenario library).
 struct Scenario {
   ControllerParameters controller;
   Eigen::VectorXd leader_initial_state;    ///< x_1(0), n

@@ -1,7 +1,7 @@
 #pragma once
 
 /// @file
-/// Reads the YAML scenario format of doc/scenario_format.md (yaml-cpp). Every error is a
+/// Reads the YAML scenario format of README.md, "Scenario files" (yaml-cpp). Every error is a
 /// ParameterError whose key is the dotted path of the offending entry.
 
 #include <string>

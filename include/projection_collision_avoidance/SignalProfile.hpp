@@ -1,15 +1,16 @@
 #pragma once
 
-#include <Eigen/Core>
 #include <string>
 #include <vector>
+
+#include <Eigen/Core>
 
 namespace projection_collision_avoidance {
 
 /// A constant vector applied for start <= t < end.
 struct Pulse {
-  double start = 0.0;   ///< s
-  double end = 0.0;     ///< s
+  double start = 0.0;  ///< s
+  double end = 0.0;    ///< s
   Eigen::VectorXd vector;
 };
 

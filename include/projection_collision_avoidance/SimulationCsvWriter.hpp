@@ -8,7 +8,7 @@
 namespace projection_collision_avoidance {
 
 /// Writes a run as CSV: a header row on construction, then one row per control tick with the
-/// columns of doc/scenario_format.md (t, xi_*, xi_hat_*, norms, bounds, f, projection_active,
+/// columns of README.md, "Scenario files" (t, xi_*, xi_hat_*, norms, bounds, f, projection_active,
 /// positions, velocities for double integrators, separation, perimeter, u_*, u_baseline_*,
 /// u_tracker_*, leader_u_*, ud_*).
 class SimulationCsvWriter {

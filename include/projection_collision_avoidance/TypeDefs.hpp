@@ -37,11 +37,11 @@ struct Dimensions {
   using StateVector = BoundedMatrix<N, 1, kMaxStates, 1>;
   using InputVector = BoundedMatrix<M, 1, kMaxInputs, 1>;
   using OutputVector = BoundedMatrix<P, 1, kMaxOutputs, 1>;
-  using StateMatrix = BoundedMatrix<N, N, kMaxStates, kMaxStates>;         ///< n x n: A, Gamma
-  using InputMatrix = BoundedMatrix<N, M, kMaxStates, kMaxInputs>;         ///< n x m: B
-  using OutputMatrix = BoundedMatrix<P, N, kMaxOutputs, kMaxStates>;       ///< p x n: C
-  using FeedbackGainMatrix = BoundedMatrix<M, P, kMaxInputs, kMaxOutputs>; ///< m x p: G, G_e
-  using ObserverGainMatrix = BoundedMatrix<N, P, kMaxStates, kMaxOutputs>; ///< n x p: L, pinv(C)
+  using StateMatrix = BoundedMatrix<N, N, kMaxStates, kMaxStates>;          ///< n x n: A, Gamma
+  using InputMatrix = BoundedMatrix<N, M, kMaxStates, kMaxInputs>;          ///< n x m: B
+  using OutputMatrix = BoundedMatrix<P, N, kMaxOutputs, kMaxStates>;        ///< p x n: C
+  using FeedbackGainMatrix = BoundedMatrix<M, P, kMaxInputs, kMaxOutputs>;  ///< m x p: G, G_e
+  using ObserverGainMatrix = BoundedMatrix<N, P, kMaxStates, kMaxOutputs>;  ///< n x p: L, pinv(C)
 };
 
 /// Double integrator on one axis: x = [p; v], u = acceleration, y = x.

@@ -1,8 +1,9 @@
 #include "projection_collision_avoidance/AgentModel.hpp"
 
-#include "ValidationChecks.hpp"
 #include "projection_collision_avoidance/ParameterError.hpp"
 #include "projection_collision_avoidance/TypeDefs.hpp"
+
+#include "ValidationChecks.hpp"
 
 namespace projection_collision_avoidance {
 
@@ -43,9 +44,9 @@ void validateAgentModel(const AgentModel& model) {
   }
   detail::requireMatrix("model.C", model.C, p, n);
   if (model.position_dimension < 1 || model.position_dimension > n) {
-    throw ParameterError("model.position_dimension",
-                         "must be between 1 and the state dimension " + std::to_string(n) +
-                             ", got " + std::to_string(model.position_dimension));
+    throw ParameterError("model.position_dimension", "must be between 1 and the state dimension " +
+                                                         std::to_string(n) + ", got " +
+                                                         std::to_string(model.position_dimension));
   }
 }
 

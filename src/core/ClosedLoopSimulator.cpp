@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <limits>
+#include <locale>
+#include <sstream>
+#include <string>
 #include <vector>
 
 #include "projection_collision_avoidance/ControllerDesign.hpp"
@@ -25,12 +27,12 @@ class TwoAgentPlant {
       : model_(scenario.controller.model),
         disturbance_(scenario.disturbance),
         period_(period),
+        input_matrix_(scenario.controller.model.B),
         leader_(scenario.leader_initial_state),
         follower_(scenario.follower_initial_state) {
     const ExactDiscretization nominal = ExactDiscretization::compute(model_.A, period);
     transition_ = nominal.transition;
     integral_ = nominal.integral;
-    input_matrix_ = model_.B;
   }
 
   const StateVector& leader() const { return leader_; }
@@ -44,8 +46,7 @@ class TwoAgentPlant {
     // edge that rounding puts a hair away from a tick does not flip the pulse's state.
     const double t_end = t + period_;
     const double tolerance = 1e-9 * period_;
-    const std::vector<double> edges =
-        disturbance_.edgesWithin(t + tolerance, t_end - tolerance);
+    const std::vector<double> edges = disturbance_.edgesWithin(t + tolerance, t_end - tolerance);
     if (edges.empty()) {
       advanceSegment(t, t_end, transition_, integral_, leader_drive, follower_drive);
       return;
@@ -81,8 +82,8 @@ class TwoAgentPlant {
   const AgentModel& model_;
   const SignalProfile& disturbance_;
   double period_;
-  typename Dims::StateMatrix transition_;  // Phi over one period
-  typename Dims::StateMatrix integral_;    // Psi over one period
+  typename Dims::StateMatrix transition_;    // Phi over one period
+  typename Dims::StateMatrix integral_;      // Psi over one period
   typename Dims::InputMatrix input_matrix_;  // B
   StateVector leader_;
   StateVector follower_;
@@ -164,18 +165,16 @@ SimulationSummary simulate(const Scenario& scenario, const SampleObserver& obser
   });
 }
 
-}  // namespace projection_collision_avoidance
-
-namespace projection_collision_avoidance {
-
 std::string formatSummary(const SimulationSummary& summary, double wall_seconds) {
-  char line[256];
-  std::snprintf(line, sizeof(line),
-                "max_xi=%.9g max_xi_hat=%.9g xi_max=%.9g min_separation=%.9g "
-                "time_outside=%.9g wall_s=%.9g",
-                summary.max_xi, summary.max_xi_hat, summary.xi_max, summary.min_separation,
-                summary.time_outside, wall_seconds);
-  return line;
+  // A stream in the classic locale with precision 9 and the default float format prints each
+  // value exactly as printf's "%.9g" does, without a C varargs call.
+  std::ostringstream line;
+  line.imbue(std::locale::classic());
+  line.precision(9);
+  line << "max_xi=" << summary.max_xi << " max_xi_hat=" << summary.max_xi_hat
+       << " xi_max=" << summary.xi_max << " min_separation=" << summary.min_separation
+       << " time_outside=" << summary.time_outside << " wall_s=" << wall_seconds;
+  return line.str();
 }
 
 }  // namespace projection_collision_avoidance

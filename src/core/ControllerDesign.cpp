@@ -1,13 +1,15 @@
 #include "projection_collision_avoidance/ControllerDesign.hpp"
 
+#include <cmath>
+
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
-#include <cmath>
 
-#include "ValidationChecks.hpp"
 #include "projection_collision_avoidance/LinearAlgebra.hpp"
 #include "projection_collision_avoidance/ParameterError.hpp"
+
+#include "ValidationChecks.hpp"
 
 namespace projection_collision_avoidance {
 namespace {
@@ -17,8 +19,8 @@ constexpr double kRelativeTolerance = 1e-9;
 
 void requireHurwitz(const std::string& key, const std::string& name, const Eigen::MatrixXd& M) {
   if (!isHurwitz(M)) {
-    throw ParameterError(key, name + " is not Hurwitz; its eigenvalues are " +
-                                  formatEigenvalues(eigenvalues(M)));
+    throw ParameterError(
+        key, name + " is not Hurwitz; its eigenvalues are " + formatEigenvalues(eigenvalues(M)));
   }
 }
 
@@ -29,8 +31,7 @@ void validateScalars(const ControllerParameters& p) {
   }
   detail::requireFinite("controller.alpha", p.alpha);
   if (p.alpha < 0.0 || p.alpha >= 1.0) {
-    throw ParameterError("controller.alpha",
-                         "must lie in [0, 1), got " + std::to_string(p.alpha));
+    throw ParameterError("controller.alpha", "must lie in [0, 1), got " + std::to_string(p.alpha));
   }
   detail::requireFinite("controller.epsilon", p.epsilon);
   if (p.epsilon <= 0.0) {
@@ -122,8 +123,8 @@ ControllerDesign ControllerDesign::create(const ControllerParameters& parameters
     requireHurwitz("controller.tracker.gain", "A_c - B G_e C", design.tracking_matrix);
   }
 
-  design.gamma =
-      solveContinuousLyapunov(design.estimator_matrix, p.lyapunov_weight, &design.lyapunov_residual);
+  design.gamma = solveContinuousLyapunov(design.estimator_matrix, p.lyapunov_weight,
+                                         &design.lyapunov_residual);
   if (!(design.lyapunov_residual < 1e-8)) {
     throw ParameterError("controller.estimator.lyapunov_weight",
                          "the Lyapunov equation for Gamma is ill-conditioned (relative residual " +
@@ -133,9 +134,9 @@ ControllerDesign ControllerDesign::create(const ControllerParameters& parameters
   const double gamma_min = gamma_eigen.eigenvalues().minCoeff();
   const double gamma_max = gamma_eigen.eigenvalues().maxCoeff();
   if (!(gamma_min > 0.0)) {
-    throw ParameterError("controller.estimator.lyapunov_weight",
-                         "Gamma is not positive definite (smallest eigenvalue " +
-                             std::to_string(gamma_min) + ")");
+    throw ParameterError(
+        "controller.estimator.lyapunov_weight",
+        "Gamma is not positive definite (smallest eigenvalue " + std::to_string(gamma_min) + ")");
   }
   design.gamma_inverse = gamma_eigen.eigenvectors() *
                          gamma_eigen.eigenvalues().cwiseInverse().asDiagonal() *
@@ -145,8 +146,7 @@ ControllerDesign ControllerDesign::create(const ControllerParameters& parameters
   design.estimator_decay_rate = q_min / (2.0 * gamma_max);
   design.estimator_overshoot = std::sqrt(gamma_max / gamma_min);
 
-  design.output_pseudoinverse =
-      C.completeOrthogonalDecomposition().pseudoInverse();
+  design.output_pseudoinverse = C.completeOrthogonalDecomposition().pseudoInverse();
   design.period = 1.0 / p.control_rate;
   const double d_norm = p.separation.norm();
   design.xi_max = (1.0 - p.alpha) * d_norm;

@@ -1,8 +1,11 @@
 #include "projection_collision_avoidance/LinearAlgebra.hpp"
 
+#include <cmath>
+#include <sstream>
+#include <string>
+
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
-#include <sstream>
 
 namespace projection_collision_avoidance {
 

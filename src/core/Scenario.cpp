@@ -8,8 +8,7 @@ void Scenario::validate() const {
   const AgentModel& model = controller.model;
   validateAgentModel(model);
   detail::requireVector("leader.initial_state", leader_initial_state, model.stateDimension());
-  detail::requireVector("follower.initial_state", follower_initial_state,
-                        model.stateDimension());
+  detail::requireVector("follower.initial_state", follower_initial_state, model.stateDimension());
   leader_input.validate("leader.input", model.inputDimension());
   if (!disturbance.sinusoids.empty()) {
     throw ParameterError("leader.disturbance", "takes pulses only");

@@ -1,6 +1,7 @@
 #include "projection_collision_avoidance/SimulationCsvWriter.hpp"
 
 #include <cmath>
+#include <ostream>
 #include <string>
 
 namespace projection_collision_avoidance {
@@ -25,11 +26,10 @@ SimulationCsvWriter::SimulationCsvWriter(std::ostream& out, const Scenario& scen
       states_(scenario.controller.model.stateDimension()),
       inputs_(scenario.controller.model.inputDimension()),
       positions_(scenario.controller.model.position_dimension),
-      velocities_(scenario.controller.model.isDoubleIntegrator()) {
-  const double d_norm = scenario.controller.separation.norm();
-  xi_max_ = (1.0 - scenario.controller.alpha) * d_norm;
-  xi_soft_ = xi_max_ / std::sqrt(1.0 + scenario.controller.epsilon);
-  perimeter_ = scenario.controller.alpha * d_norm;
+      velocities_(scenario.controller.model.isDoubleIntegrator()),
+      xi_max_((1.0 - scenario.controller.alpha) * scenario.controller.separation.norm()),
+      xi_soft_(xi_max_ / std::sqrt(1.0 + scenario.controller.epsilon)),  // xi_max_ is set above
+      perimeter_(scenario.controller.alpha * scenario.controller.separation.norm()) {
   out_.precision(10);
   out_ << 't';
   writeHeaderColumns(out_, "xi_", states_);

@@ -3,15 +3,15 @@
 /// @file
 /// Checks shared by the validators of the core (internal header).
 
-#include <Eigen/Core>
 #include <cmath>
 #include <string>
+
+#include <Eigen/Core>
 
 #include "projection_collision_avoidance/LinearAlgebra.hpp"
 #include "projection_collision_avoidance/ParameterError.hpp"
 
-namespace projection_collision_avoidance {
-namespace detail {
+namespace projection_collision_avoidance::detail {
 
 inline std::string shapeOf(Eigen::Index rows, Eigen::Index cols) {
   return std::to_string(rows) + "x" + std::to_string(cols);
@@ -21,8 +21,8 @@ inline std::string shapeOf(Eigen::Index rows, Eigen::Index cols) {
 inline void requireMatrix(const std::string& key, const Eigen::MatrixXd& M, Eigen::Index rows,
                           Eigen::Index cols) {
   if (M.rows() != rows || M.cols() != cols) {
-    throw ParameterError(key, "must be " + shapeOf(rows, cols) + ", got " +
-                                  shapeOf(M.rows(), M.cols()));
+    throw ParameterError(key,
+                         "must be " + shapeOf(rows, cols) + ", got " + shapeOf(M.rows(), M.cols()));
   }
   if (!allFinite(M)) {
     throw ParameterError(key, "has a non-finite entry");
@@ -32,8 +32,8 @@ inline void requireMatrix(const std::string& key, const Eigen::MatrixXd& M, Eige
 /// Throws ParameterError(key) unless v has size entries, all finite.
 inline void requireVector(const std::string& key, const Eigen::VectorXd& v, Eigen::Index size) {
   if (v.size() != size) {
-    throw ParameterError(key, "must have " + std::to_string(size) + " entries, got " +
-                                  std::to_string(v.size()));
+    throw ParameterError(
+        key, "must have " + std::to_string(size) + " entries, got " + std::to_string(v.size()));
   }
   if (!v.allFinite()) {
     throw ParameterError(key, "has a non-finite entry");
@@ -46,5 +46,4 @@ inline void requireFinite(const std::string& key, double value) {
   }
 }
 
-}  // namespace detail
-}  // namespace projection_collision_avoidance
+}  // namespace projection_collision_avoidance::detail

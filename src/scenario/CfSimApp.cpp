@@ -1,8 +1,12 @@
 #include "projection_collision_avoidance/CfSimApp.hpp"
 
 #include <chrono>
+#include <cstddef>
 #include <fstream>
 #include <memory>
+#include <ostream>
+#include <string>
+#include <vector>
 
 #include "projection_collision_avoidance/ClosedLoopSimulator.hpp"
 #include "projection_collision_avoidance/ParameterError.hpp"

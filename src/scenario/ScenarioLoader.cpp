@@ -1,18 +1,28 @@
 #include "projection_collision_avoidance/ScenarioLoader.hpp"
 
-#include <yaml-cpp/yaml.h>
-
+#include <cstddef>
+#include <exception>
 #include <fstream>
 #include <set>
 #include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
 
-#include "YamlReader.hpp"
+#include <yaml-cpp/yaml.h>
+
 #include "projection_collision_avoidance/ControllerDesign.hpp"
 #include "projection_collision_avoidance/ParameterError.hpp"
+
+#include "YamlReader.hpp"
 
 namespace projection_collision_avoidance {
 namespace {
 
+/// Sets the entry at path[index..] below @p node. Recurses once per path element of an
+/// override ("a.b.0.c"), so the depth is bounded by the length of a command-line key; the
+/// scenario loader runs at start-up, never in a control step.
+// NOLINTNEXTLINE(misc-no-recursion)
 void setAtPath(YAML::Node node, const std::vector<std::string>& path, std::size_t index,
                const YAML::Node& value, const std::string& full_key) {
   const std::string& element = path[index];
@@ -108,8 +118,7 @@ Eigen::MatrixXd readGain(detail::YamlReader& section, const AgentModel& model) {
   if (!pole_form) {
     return section.matrix("gain", model.inputDimension(), model.outputDimension());
   }
-  if (!model.isDoubleIntegrator() ||
-      !model.C.isIdentity(0.0)) {
+  if (!model.isDoubleIntegrator() || !model.C.isIdentity(0.0)) {
     throw ParameterError(section.key("natural_frequency"),
                          "needs a double_integrator model with C = identity; give gain instead");
   }
@@ -157,9 +166,8 @@ ControllerParameters readController(detail::YamlReader& reader, const AgentModel
   detail::YamlReader tracker = controller.map("tracker");
   result.tracker_enabled = tracker.boolean("enabled");
   result.tracker_gain = readGain(tracker, model);
-  result.reference_gain = tracker.has("reference_gain")
-                              ? tracker.matrix("reference_gain", m, p)
-                              : Eigen::MatrixXd::Zero(m, p);
+  result.reference_gain = tracker.has("reference_gain") ? tracker.matrix("reference_gain", m, p)
+                                                        : Eigen::MatrixXd::Zero(m, p);
   tracker.finish();
 
   if (controller.has("leader_information")) {

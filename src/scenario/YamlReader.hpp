@@ -4,16 +4,17 @@
 /// Typed, key-tracking access to one YAML map of a scenario (internal to the scenario library).
 /// Every read marks its key as known; finish() refuses the keys nobody read.
 
-#include <yaml-cpp/yaml.h>
-
-#include <Eigen/Core>
+#include <cstddef>
 #include <set>
 #include <string>
+#include <utility>
+
+#include <Eigen/Core>
+#include <yaml-cpp/yaml.h>
 
 #include "projection_collision_avoidance/ParameterError.hpp"
 
-namespace projection_collision_avoidance {
-namespace detail {
+namespace projection_collision_avoidance::detail {
 
 class YamlReader {
  public:
@@ -41,12 +42,10 @@ class YamlReader {
     if (!child.IsMap()) {
       throw ParameterError(key(name), "must be a map");
     }
-    return YamlReader(child, key(name));
+    return {child, key(name)};
   }
 
-  std::string string(const std::string& name) {
-    return scalar<std::string>(name, "a string");
-  }
+  std::string string(const std::string& name) { return scalar<std::string>(name, "a string"); }
   double number(const std::string& name) { return scalar<double>(name, "a number"); }
   bool boolean(const std::string& name) { return scalar<bool>(name, "true or false"); }
 
@@ -84,15 +83,16 @@ class YamlReader {
       }
       const Eigen::Index size = rows >= 0 ? rows : cols;
       if (size < 0 || (rows >= 0 && cols >= 0 && rows != cols)) {
-        throw ParameterError(key(name), "a number stands for s * I and needs a square matrix "
-                                        "of known size; give a list of rows");
+        throw ParameterError(key(name),
+                             "a number stands for s * I and needs a square matrix "
+                             "of known size; give a list of rows");
       }
       return value * Eigen::MatrixXd::Identity(size, size);
     }
     if (!child.IsSequence() || child.size() == 0) {
       throw ParameterError(key(name), "must be a list of rows or a number");
     }
-    const Eigen::Index row_count = static_cast<Eigen::Index>(child.size());
+    const auto row_count = static_cast<Eigen::Index>(child.size());
     Eigen::MatrixXd result;
     for (Eigen::Index i = 0; i < row_count; ++i) {
       const YAML::Node row = child[static_cast<std::size_t>(i)];
@@ -126,13 +126,13 @@ class YamlReader {
     if (!child.IsMap()) {
       throw ParameterError(item_key, "must be a map");
     }
-    return YamlReader(child, item_key);
+    return {child, item_key};
   }
 
   /// Refuses every key of this map that was not read.
   void finish() const {
     for (const auto& entry : node_) {
-      const std::string name = entry.first.as<std::string>();
+      const auto name = entry.first.as<std::string>();
       if (used_.count(name) == 0) {
         throw ParameterError(key(name), "unknown key");
       }
@@ -191,5 +191,4 @@ class YamlReader {
   std::set<std::string> used_;
 };
 
-}  // namespace detail
-}  // namespace projection_collision_avoidance
+}  // namespace projection_collision_avoidance::detail

@@ -1,9 +1,9 @@
 /// Google Benchmark of one control step of the follower (1-D, 2-D and 3-D double integrators)
 /// and of a whole cf_sim run of the paper's scenario. Not a test: run it by hand, see README.
 
-#include <benchmark/benchmark.h>
-
 #include <cmath>
+
+#include <benchmark/benchmark.h>
 
 #include "projection_collision_avoidance/ClosedLoopSimulator.hpp"
 #include "projection_collision_avoidance/ControllerDesign.hpp"
@@ -14,9 +14,7 @@
 namespace projection_collision_avoidance {
 namespace {
 
-std::string scenarioPath(const char* name) {
-  return std::string(SCENARIO_DIR) + "/" + name;
-}
+std::string scenarioPath(const char* name) { return std::string(SCENARIO_DIR) + "/" + name; }
 
 /// The paper's Run 2 in k axes, along the diagonal so that every axis is used.
 Scenario paperScenario(int axes) {
@@ -49,8 +47,8 @@ void BM_PaperRun2(benchmark::State& state) {
   for (auto _ : state) {
     benchmark::DoNotOptimize(simulate(scenario).max_xi);
   }
-  state.counters["ticks"] = static_cast<double>(std::lround(scenario.duration *
-                                                            scenario.controller.control_rate)) + 1;
+  state.counters["ticks"] =
+      static_cast<double>(std::lround(scenario.duration * scenario.controller.control_rate)) + 1;
 }
 BENCHMARK(BM_PaperRun2)->Unit(benchmark::kMillisecond);
 

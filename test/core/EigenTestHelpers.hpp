@@ -3,13 +3,13 @@
 /// @file
 /// Eigen-aware gtest assertions that print both operands on failure, and random generators.
 
-#include <gtest/gtest.h>
+#include <random>
+#include <sstream>
 
 #include <Eigen/Core>
 #include <Eigen/LU>
 #include <Eigen/QR>
-#include <random>
-#include <sstream>
+#include <gtest/gtest.h>
 
 namespace projection_collision_avoidance {
 namespace testing {

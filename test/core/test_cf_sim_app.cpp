@@ -1,14 +1,15 @@
 /// The cf_sim command: exit codes, the summary line and the CSV.
 
-#include <gtest/gtest.h>
-
 #include <cstdio>
 #include <fstream>
 #include <map>
 #include <sstream>
 
-#include "TestScenarios.hpp"
+#include <gtest/gtest.h>
+
 #include "projection_collision_avoidance/CfSimApp.hpp"
+
+#include "TestScenarios.hpp"
 
 namespace projection_collision_avoidance {
 namespace {
@@ -57,8 +58,8 @@ TEST(CfSim, PrintsTheSummaryLine) {
 
 TEST(CfSim, WritesTheCsv) {
   const std::string path = ::testing::TempDir() + "cf_sim_test.csv";
-  const Result result = runApp({scenarioPath("paper_run2.yaml"), "--csv", path, "--set",
-                                "simulation.duration=1.0"});
+  const Result result =
+      runApp({scenarioPath("paper_run2.yaml"), "--csv", path, "--set", "simulation.duration=1.0"});
   ASSERT_EQ(result.code, 0) << result.err;
   std::ifstream csv(path);
   std::string header;

@@ -1,18 +1,19 @@
 /// Validation of controller parameters: every class of invalid parameter is refused with its
 /// key, and the derived quantities (Gamma, bounds, gains) are right.
 
-#include <gtest/gtest.h>
-
-#include <Eigen/Eigenvalues>
 #include <functional>
 #include <limits>
 #include <random>
 
-#include "EigenTestHelpers.hpp"
-#include "TestScenarios.hpp"
+#include <Eigen/Eigenvalues>
+#include <gtest/gtest.h>
+
 #include "projection_collision_avoidance/ControllerDesign.hpp"
 #include "projection_collision_avoidance/LinearAlgebra.hpp"
 #include "projection_collision_avoidance/ParameterError.hpp"
+
+#include "EigenTestHelpers.hpp"
+#include "TestScenarios.hpp"
 
 namespace projection_collision_avoidance {
 namespace {
@@ -23,8 +24,8 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 /// Expects create() to refuse the parameters with @p key, and the message to contain @p text.
-void expectRefused(const std::function<void(ControllerParameters&)>& change,
-                   const std::string& key, const std::string& text = "") {
+void expectRefused(const std::function<void(ControllerParameters&)>& change, const std::string& key,
+                   const std::string& text = "") {
   ControllerParameters p = paperParameters();
   change(p);
   try {

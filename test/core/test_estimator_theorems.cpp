@@ -1,16 +1,17 @@
 /// Theorems 3.1 and 3.2 of the paper, checked on the implementation.
 
-#include <gtest/gtest.h>
+#include <random>
 
 #include <Eigen/Eigenvalues>
-#include <random>
+#include <gtest/gtest.h>
 #include <unsupported/Eigen/MatrixFunctions>
 
-#include "EigenTestHelpers.hpp"
-#include "TestScenarios.hpp"
 #include "projection_collision_avoidance/ClosedLoopSimulator.hpp"
 #include "projection_collision_avoidance/ControllerDesign.hpp"
 #include "projection_collision_avoidance/FollowerController.hpp"
+
+#include "EigenTestHelpers.hpp"
+#include "TestScenarios.hpp"
 
 namespace projection_collision_avoidance {
 namespace {
@@ -42,7 +43,8 @@ TEST(Theorem31, EstimationErrorDecaysAtTheProvenRateWithXiAtRest) {
     int projected_periods = 0;
     for (int trial = 0; trial < 50; ++trial) {
       FollowerController<DoubleIntegrator1D> controller(design);
-      const Eigen::Vector2d start = testing::randomOnSphere(rng, 2, design.xi_max * (trial % 5 + 1) / 5.0);
+      const Eigen::Vector2d start =
+          testing::randomOnSphere(rng, 2, design.xi_max * (trial % 5 + 1) / 5.0);
       controller.resetEstimate(start);
       const double e0 = start.norm();
       for (int k = 0; k <= 1000; ++k) {
@@ -106,7 +108,8 @@ TEST(Theorem32, TrackingErrorDecays) {
   ASSERT_GT(errors.front(), 1.0);
   // Exponential decay: the error shrinks by at least a constant factor every 2 s, down to
   // rounding level.
-  const std::size_t per_two_seconds = static_cast<std::size_t>(2.0 * scenario.controller.control_rate);
+  const std::size_t per_two_seconds =
+      static_cast<std::size_t>(2.0 * scenario.controller.control_rate);
   for (std::size_t k = per_two_seconds; k < errors.size(); k += per_two_seconds) {
     if (errors[k - per_two_seconds] < 1e-10) {
       break;

@@ -3,17 +3,18 @@
 /// and Eigen's aligned_malloc all end in malloc. (Not for sanitizer builds, which replace malloc
 /// themselves.)
 
-#include <gtest/gtest.h>
-
-#include <Eigen/Core>
 #include <atomic>
 #include <cstddef>
 #include <vector>
 
-#include "TestScenarios.hpp"
+#include <Eigen/Core>
+#include <gtest/gtest.h>
+
 #include "projection_collision_avoidance/ControllerDesign.hpp"
 #include "projection_collision_avoidance/FollowerController.hpp"
 #include "projection_collision_avoidance/ScenarioEmbedding.hpp"
+
+#include "TestScenarios.hpp"
 
 namespace {
 std::atomic<long> g_allocations{0};

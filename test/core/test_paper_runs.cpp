@@ -2,11 +2,12 @@
 
 #include <gtest/gtest.h>
 
-#include "EigenTestHelpers.hpp"
-#include "TestScenarios.hpp"
 #include "projection_collision_avoidance/ClosedLoopSimulator.hpp"
 #include "projection_collision_avoidance/ScenarioEmbedding.hpp"
 #include "projection_collision_avoidance/ScenarioLoader.hpp"
+
+#include "EigenTestHelpers.hpp"
+#include "TestScenarios.hpp"
 
 namespace projection_collision_avoidance {
 namespace {
@@ -20,7 +21,8 @@ struct Trace {
 
 Trace run(const Scenario& scenario) {
   Trace trace;
-  trace.summary = simulate(scenario, [&](const SimulationSample& s) { trace.samples.push_back(s); });
+  trace.summary =
+      simulate(scenario, [&](const SimulationSample& s) { trace.samples.push_back(s); });
   return trace;
 }
 
@@ -84,9 +86,9 @@ TEST(PaperRuns, RotatedIntoTwoAndThreeDimensionsGivesTheSameNorms) {
   for (const char* name : {"paper_run1.yaml", "paper_run2.yaml"}) {
     const Scenario one_axis = loadScenarioFile(scenarioPath(name));
     const Trace reference = run(one_axis);
-    for (const Eigen::VectorXd& direction :
-         {Eigen::VectorXd(Eigen::Vector2d(0.6, -0.8)), Eigen::VectorXd(Eigen::Vector3d(1.0, 2.0, -2.0)),
-          Eigen::VectorXd(Eigen::Vector3d(0.0, 0.0, 1.0))}) {
+    for (const Eigen::VectorXd& direction : {Eigen::VectorXd(Eigen::Vector2d(0.6, -0.8)),
+                                             Eigen::VectorXd(Eigen::Vector3d(1.0, 2.0, -2.0)),
+                                             Eigen::VectorXd(Eigen::Vector3d(0.0, 0.0, 1.0))}) {
       const Trace rotated = run(embedAlongDirection(one_axis, direction));
       ASSERT_EQ(rotated.samples.size(), reference.samples.size());
       EXPECT_NEAR(rotated.summary.max_xi, reference.summary.max_xi, 1e-9);

@@ -2,15 +2,16 @@
 /// reading of the paper's eqs. (12)/(15), and the invariance of Omega_1 under the discretised
 /// estimator.
 
-#include <gtest/gtest.h>
-
 #include <random>
 
-#include "EigenTestHelpers.hpp"
+#include <gtest/gtest.h>
+
 #include "projection_collision_avoidance/BallConstraint.hpp"
 #include "projection_collision_avoidance/CollisionFreeEstimator.hpp"
 #include "projection_collision_avoidance/ControllerDesign.hpp"
 #include "projection_collision_avoidance/ProjectionOperator.hpp"
+
+#include "EigenTestHelpers.hpp"
 
 namespace projection_collision_avoidance {
 namespace {
@@ -56,8 +57,8 @@ TEST(ProjectionOperator, NeverPointsOutwardOnOrBeyondTheBoundary) {
     const double outward = ball.gradient(x).dot(rate);
     // On the sphere the outward rate is zero up to rounding; beyond it, strictly inward.
     ASSERT_LE(outward, 1e-9 * ball.gradient(x).norm() * h.norm())
-        << "n=" << n << " f=" << ball.value(x) << "\nGamma=\n" << gamma << "\nx=" << x.transpose()
-        << "\nh=" << h.transpose();
+        << "n=" << n << " f=" << ball.value(x) << "\nGamma=\n"
+        << gamma << "\nx=" << x.transpose() << "\nh=" << h.transpose();
   }
   EXPECT_GT(active, 5000);  // the test exercised the projection, not only the pass-through
 }
@@ -74,7 +75,8 @@ TEST(ProjectionOperator, LyapunovInequalityForXiInsideTheHardBound) {
     const Eigen::VectorXd x = randomOnSphere(rng, n, kXiMax * (1.0 + 0.5 * unit(rng)));
     const Eigen::VectorXd xi = randomOnSphere(rng, n, kXiMax * unit(rng));
     const Eigen::VectorXd h = randomVector(rng, n, 10.0);
-    const Eigen::VectorXd rate = projectDrift(ball, x, h, Eigen::MatrixXd(gamma.inverse()), nullptr);
+    const Eigen::VectorXd rate =
+        projectDrift(ball, x, h, Eigen::MatrixXd(gamma.inverse()), nullptr);
     const double value = (x - xi).dot(gamma * (rate - h));
     ASSERT_LE(value, 1e-9 * (1.0 + gamma.norm() * h.norm() * x.norm()));
   }
@@ -93,7 +95,8 @@ TEST(ProjectionOperator, LyapunovInequalityInTheBandForXiInsideTheSoftBound) {
     const Eigen::VectorXd x = randomOnSphere(rng, n, r);
     const Eigen::VectorXd xi = randomOnSphere(rng, n, r * unit(rng));
     const Eigen::VectorXd h = randomVector(rng, n, 10.0);
-    const Eigen::VectorXd rate = projectDrift(ball, x, h, Eigen::MatrixXd(gamma.inverse()), nullptr);
+    const Eigen::VectorXd rate =
+        projectDrift(ball, x, h, Eigen::MatrixXd(gamma.inverse()), nullptr);
     ASSERT_LE((x - xi).dot(gamma * (rate - h)), 1e-9 * (1.0 + gamma.norm() * h.norm() * x.norm()));
   }
 }
@@ -152,8 +155,8 @@ TEST(ProjectionOperator, PassesTheDriftThroughInsideTheSoftBound) {
   const Eigen::VectorXd x = Eigen::Vector2d(1.0, 2.0);
   const Eigen::VectorXd h = Eigen::Vector2d(5.0, 7.0);
   bool active = false;
-  EXPECT_MATRIX_NEAR(projectDrift(ball, x, h, Eigen::MatrixXd(Eigen::Matrix2d::Identity()), &active),
-                     h, 0.0);
+  EXPECT_MATRIX_NEAR(
+      projectDrift(ball, x, h, Eigen::MatrixXd(Eigen::Matrix2d::Identity()), &active), h, 0.0);
   EXPECT_FALSE(active);
 }
 

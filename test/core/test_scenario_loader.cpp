@@ -1,14 +1,15 @@
 /// The YAML scenario loader: the paper's files, overrides, and every error naming its key.
 
-#include <gtest/gtest.h>
-
 #include <fstream>
 #include <sstream>
 
-#include "EigenTestHelpers.hpp"
-#include "TestScenarios.hpp"
+#include <gtest/gtest.h>
+
 #include "projection_collision_avoidance/ParameterError.hpp"
 #include "projection_collision_avoidance/ScenarioLoader.hpp"
+
+#include "EigenTestHelpers.hpp"
+#include "TestScenarios.hpp"
 
 namespace projection_collision_avoidance {
 namespace {
@@ -63,17 +64,18 @@ TEST(ScenarioLoader, ReadsThePapersRun) {
 }
 
 TEST(ScenarioLoader, AppliesOverridesByDottedPath) {
-  const Scenario s = parseScenario(
-      paperText(),
-      {"controller.alpha=0.3", "controller.tracker.enabled=false",
-       "leader.disturbance.0.vector=[-1.5, -0.5]", "controller.estimator.gain=[[-4, 0], [0, -6]]",
-       "leader.input={pulses: [{start: 1, end: 2, vector: [0.5]}], "
-       "sinusoids: [{amplitude: [0.2], frequency: 0.5}]}",
-       "controller.leader_information.command=true"});
+  const Scenario s =
+      parseScenario(paperText(), {"controller.alpha=0.3", "controller.tracker.enabled=false",
+                                  "leader.disturbance.0.vector=[-1.5, -0.5]",
+                                  "controller.estimator.gain=[[-4, 0], [0, -6]]",
+                                  "leader.input={pulses: [{start: 1, end: 2, vector: [0.5]}], "
+                                  "sinusoids: [{amplitude: [0.2], frequency: 0.5}]}",
+                                  "controller.leader_information.command=true"});
   EXPECT_DOUBLE_EQ(s.controller.alpha, 0.3);
   EXPECT_FALSE(s.controller.tracker_enabled);
   EXPECT_MATRIX_NEAR(s.disturbance.pulses[0].vector, Eigen::Vector2d(-1.5, -0.5), 0.0);
-  EXPECT_MATRIX_NEAR(s.controller.estimator_gain, (Eigen::Matrix2d() << -4, 0, 0, -6).finished(), 0.0);
+  EXPECT_MATRIX_NEAR(s.controller.estimator_gain, (Eigen::Matrix2d() << -4, 0, 0, -6).finished(),
+                     0.0);
   ASSERT_EQ(s.leader_input.pulses.size(), 1u);
   ASSERT_EQ(s.leader_input.sinusoids.size(), 1u);
   EXPECT_DOUBLE_EQ(s.leader_input.sinusoids[0].frequency, 0.5);
@@ -85,19 +87,20 @@ TEST(ScenarioLoader, AppliesOverridesByDottedPath) {
 
 TEST(ScenarioLoader, PoleFormAndScalarMatrices) {
   const Scenario s = parseScenario(
-      paperText(), {"model.dimension=2", "controller.separation=[3, 4, 0, 0]",
-                    "controller.baseline.natural_frequency=[1, 2]",
-                    "controller.baseline.damping=0.5",
-                    "controller.tracker={enabled: true, natural_frequency: 3, damping: 1}",
-                    "leader.initial_state=[3, 4, 0, 0]", "follower.initial_state=[0, 0, 0, 0]",
-                    "leader.disturbance=[]"});
+      paperText(),
+      {"model.dimension=2", "controller.separation=[3, 4, 0, 0]",
+       "controller.baseline.natural_frequency=[1, 2]", "controller.baseline.damping=0.5",
+       "controller.tracker={enabled: true, natural_frequency: 3, damping: 1}",
+       "leader.initial_state=[3, 4, 0, 0]", "follower.initial_state=[0, 0, 0, 0]",
+       "leader.disturbance=[]"});
   Eigen::MatrixXd G(2, 4);
   G << 1, 0, 1, 0, 0, 4, 0, 2;
   EXPECT_MATRIX_NEAR(s.controller.baseline_gain, G, 1e-15);
   Eigen::MatrixXd Ge(2, 4);
   Ge << 9, 0, 6, 0, 0, 9, 0, 6;
   EXPECT_MATRIX_NEAR(s.controller.tracker_gain, Ge, 1e-15);
-  EXPECT_MATRIX_NEAR(s.controller.estimator_gain, Eigen::MatrixXd(-5.0 * Eigen::Matrix4d::Identity()), 0.0);
+  EXPECT_MATRIX_NEAR(s.controller.estimator_gain,
+                     Eigen::MatrixXd(-5.0 * Eigen::Matrix4d::Identity()), 0.0);
   EXPECT_MATRIX_NEAR(s.controller.reference_gain, Eigen::MatrixXd::Zero(2, 4), 0.0);
   // 0 stands for the zero matrix of any shape; other numbers need a square matrix.
   const Scenario zero = parseScenario(paperText(), {"controller.tracker.reference_gain=0"});
@@ -145,10 +148,12 @@ TEST(ScenarioLoader, RefusesWrongTypes) {
   expectKey({"controller.estimator.substeps=2.5"}, "controller.estimator.substeps", "whole");
   expectKey({"controller.separation=5"}, "controller.separation", "list of numbers");
   expectKey({"controller.baseline={gain: [1, 1.4]}"}, "controller.baseline.gain", "list of rows");
-  expectKey({"controller.baseline={gain: [[1, 1.4], [1]]}"}, "controller.baseline.gain", "different");
+  expectKey({"controller.baseline={gain: [[1, 1.4], [1]]}"}, "controller.baseline.gain",
+            "different");
   expectKey({"controller.baseline=3"}, "controller.baseline", "a map");
   expectKey({"model.type=triple_integrator"}, "model.type", "double_integrator or linear");
-  expectKey({"controller.estimator.initial_estimate=guess"}, "controller.estimator.initial_estimate");
+  expectKey({"controller.estimator.initial_estimate=guess"},
+            "controller.estimator.initial_estimate");
 }
 
 TEST(ScenarioLoader, RefusesWrongSizesAndValues) {
