@@ -73,6 +73,9 @@ class FollowerController {
     initialized_ = true;
   }
 
+  /// False until the first step (or resetEstimate()) has set the estimate.
+  bool initialized() const { return initialized_; }
+
   /// The estimate that the next step will use (m).
   const StateVector& estimate() const { return estimator_.estimate(); }
   const FollowerStatus<Dims>& status() const { return status_; }

@@ -12,6 +12,7 @@
 
 #include "projection_collision_avoidance/ControllerDesign.hpp"
 #include "projection_collision_avoidance/FollowerController.hpp"
+#include "projection_collision_avoidance/RuntimeFollowerController.hpp"
 #include "projection_collision_avoidance/ScenarioEmbedding.hpp"
 
 #include "TestScenarios.hpp"
@@ -105,6 +106,22 @@ TEST(NoAllocation, ControlStepsOfFixedSizeControllers) {
     EXPECT_EQ(allocationsDuringSteps<DoubleIntegrator1D>(designFor(1, share), 1000), 0);
     EXPECT_EQ(allocationsDuringSteps<DoubleIntegrator2D>(designFor(2, share), 1000), 0);
     EXPECT_EQ(allocationsDuringSteps<DoubleIntegrator3D>(designFor(3, share), 1000), 0);
+  }
+}
+
+TEST(NoAllocation, ControlStepsOfTheRuntimeController) {
+  for (const int axes : {1, 3}) {
+    RuntimeFollowerController controller(designFor(axes, true));
+    Eigen::VectorXd y = Eigen::VectorXd::Constant(2 * axes, 0.2);
+    const Eigen::VectorXd u1 = Eigen::VectorXd::Constant(axes, 0.3);
+    controller.step(y);
+    const long before = g_allocations.load();
+    for (int k = 0; k < 1000; ++k) {
+      y.setConstant((k / 50) % 2 == 0 ? 0.2 : 7.0);
+      controller.step(y);
+      controller.step(y, u1);
+    }
+    EXPECT_EQ(g_allocations.load() - before, 0) << axes << " axes";
   }
 }
 

@@ -1,0 +1,68 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <variant>
+
+#include "projection_collision_avoidance/ControllerDesign.hpp"
+#include "projection_collision_avoidance/FollowerController.hpp"
+#include "projection_collision_avoidance/TypeDefs.hpp"
+
+namespace projection_collision_avoidance {
+
+/// FollowerStatus with run-time sized vectors, for callers that learn the model's sizes from
+/// configuration (the ROS nodes). The vectors are sized once; a step only overwrites them.
+struct RuntimeFollowerStatus {
+  Eigen::VectorXd command;              ///< u_2
+  Eigen::VectorXd baseline_command;     ///< G y (2)
+  Eigen::VectorXd tracker_command;      ///< u_a (19)
+  Eigen::VectorXd feedforward_command;  ///< u_1 when shared into the command
+  Eigen::VectorXd estimate;             ///< xi_hat used at this tick (m)
+  double estimate_norm = 0.0;           ///< ||xi_hat|| (m)
+  double constraint_value = 0.0;        ///< f(xi_hat) (13)
+  bool projection_active = false;
+  double boundary_correction = 0.0;     ///< (m)
+};
+
+/// A FollowerController whose compile-time dimensions are chosen at run time from the model
+/// (visitDimensions()): fixed-size for 1/2/3-axis double integrators, bounded otherwise. A step
+/// allocates no memory.
+class RuntimeFollowerController {
+ public:
+  /// @param design validated parameters
+  explicit RuntimeFollowerController(const ControllerDesign& design);
+
+  /// One control period (see FollowerController::step()).
+  /// @param y measurement C xi, outputDimension() entries, finite
+  const RuntimeFollowerStatus& step(const Eigen::Ref<const Eigen::VectorXd>& y);
+
+  /// One control period with the leader's input u_1 (inputDimension() entries).
+  const RuntimeFollowerStatus& step(const Eigen::Ref<const Eigen::VectorXd>& y,
+                                    const Eigen::Ref<const Eigen::VectorXd>& leader_input);
+
+  /// Replaces the parameters (for example from dynamic_reconfigure) and keeps the estimate,
+  /// moved into the new Omega_1. Throws std::invalid_argument if the model's sizes change.
+  void setDesign(const ControllerDesign& design);
+
+  /// Forgets the estimate; the next step initialises it as configured.
+  void reset();
+
+  const ControllerDesign& design() const;
+  const RuntimeFollowerStatus& status() const { return status_; }
+  /// The estimate the next step will use (m).
+  Eigen::VectorXd estimate() const;
+  int stateDimension() const { return design().parameters.model.stateDimension(); }
+  int inputDimension() const { return design().parameters.model.inputDimension(); }
+  int outputDimension() const { return design().parameters.model.outputDimension(); }
+
+ private:
+  using Variant =
+      std::variant<FollowerController<DoubleIntegrator1D>, FollowerController<DoubleIntegrator2D>,
+                   FollowerController<DoubleIntegrator3D>, FollowerController<GenericDimensions>>;
+
+  static Variant makeController(const ControllerDesign& design);
+
+  Variant controller_;
+  RuntimeFollowerStatus status_;
+};
+
+}  // namespace projection_collision_avoidance

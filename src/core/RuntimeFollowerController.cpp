@@ -1,0 +1,111 @@
+#include "projection_collision_avoidance/RuntimeFollowerController.hpp"
+
+#include <stdexcept>
+#include <utility>
+
+#include "projection_collision_avoidance/DimensionDispatch.hpp"
+
+namespace projection_collision_avoidance {
+namespace {
+
+template <typename Dims>
+void copyStatus(const FollowerStatus<Dims>& from, RuntimeFollowerStatus* to) {
+  to->command = from.command;
+  to->baseline_command = from.baseline_command;
+  to->tracker_command = from.tracker_command;
+  to->feedforward_command = from.feedforward_command;
+  to->estimate = from.estimate;
+  to->estimate_norm = from.estimate_norm;
+  to->constraint_value = from.constraint_value;
+  to->projection_active = from.projection_active;
+  to->boundary_correction = from.boundary_correction;
+}
+
+}  // namespace
+
+RuntimeFollowerController::Variant RuntimeFollowerController::makeController(
+    const ControllerDesign& design) {
+  return visitDimensions(design.parameters.model, [&design](auto dims) {
+    return Variant(std::in_place_type<FollowerController<decltype(dims)>>, design);
+  });
+}
+
+RuntimeFollowerController::RuntimeFollowerController(const ControllerDesign& design)
+    : controller_(makeController(design)) {
+  const Eigen::Index n = design.parameters.model.stateDimension();
+  const Eigen::Index m = design.parameters.model.inputDimension();
+  status_.command = Eigen::VectorXd::Zero(m);
+  status_.baseline_command = Eigen::VectorXd::Zero(m);
+  status_.tracker_command = Eigen::VectorXd::Zero(m);
+  status_.feedforward_command = Eigen::VectorXd::Zero(m);
+  status_.estimate = Eigen::VectorXd::Zero(n);
+}
+
+const RuntimeFollowerStatus& RuntimeFollowerController::step(
+    const Eigen::Ref<const Eigen::VectorXd>& y) {
+  std::visit(
+      [&](auto& controller) {
+        using Controller = std::decay_t<decltype(controller)>;
+        const typename Controller::OutputVector measurement = y;
+        copyStatus(controller.step(measurement), &status_);
+      },
+      controller_);
+  return status_;
+}
+
+const RuntimeFollowerStatus& RuntimeFollowerController::step(
+    const Eigen::Ref<const Eigen::VectorXd>& y,
+    const Eigen::Ref<const Eigen::VectorXd>& leader_input) {
+  std::visit(
+      [&](auto& controller) {
+        using Controller = std::decay_t<decltype(controller)>;
+        const typename Controller::OutputVector measurement = y;
+        const typename Controller::InputVector input = leader_input;
+        copyStatus(controller.step(measurement, input), &status_);
+      },
+      controller_);
+  return status_;
+}
+
+void RuntimeFollowerController::setDesign(const ControllerDesign& design) {
+  const AgentModel& now = this->design().parameters.model;
+  const AgentModel& next = design.parameters.model;
+  if (now.stateDimension() != next.stateDimension() ||
+      now.inputDimension() != next.inputDimension() ||
+      now.outputDimension() != next.outputDimension()) {
+    throw std::invalid_argument("RuntimeFollowerController::setDesign: model sizes changed");
+  }
+  const Eigen::VectorXd kept = estimate();
+  const bool initialized =
+      std::visit([](const auto& controller) { return controller.initialized(); }, controller_);
+  Variant replacement = makeController(design);
+  if (!initialized) {
+    controller_ = std::move(replacement);
+    return;
+  }
+  std::visit(
+      [&kept](auto& controller) {
+        using Controller = std::decay_t<decltype(controller)>;
+        const typename Controller::StateVector estimate = kept;
+        controller.resetEstimate(estimate);
+      },
+      replacement);
+  controller_ = std::move(replacement);
+}
+
+void RuntimeFollowerController::reset() {
+  std::visit([](auto& controller) { controller.reset(); }, controller_);
+}
+
+const ControllerDesign& RuntimeFollowerController::design() const {
+  return std::visit(
+      [](const auto& controller) -> const ControllerDesign& { return controller.design(); },
+      controller_);
+}
+
+Eigen::VectorXd RuntimeFollowerController::estimate() const {
+  return std::visit([](const auto& controller) -> Eigen::VectorXd { return controller.estimate(); },
+                    controller_);
+}
+
+}  // namespace projection_collision_avoidance
