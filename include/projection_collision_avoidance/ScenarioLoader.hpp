@@ -4,6 +4,8 @@
 /// Reads the YAML scenario format of README.md, "Scenario files" (yaml-cpp). Every error is a
 /// ParameterError whose key is the dotted path of the offending entry.
 
+#include <yaml-cpp/yaml.h>
+
 #include <string>
 #include <vector>
 
@@ -17,6 +19,9 @@ namespace projection_collision_avoidance {
 /// @throws ParameterError for a missing file, a syntax error, an unknown or missing key, a value
 ///         of the wrong type or size, or a parameter the controller design refuses
 Scenario loadScenarioFile(const std::string& path, const std::vector<std::string>& overrides = {});
+
+/// As loadScenarioFile(), from a YAML tree (for example one converted from ROS parameters).
+Scenario scenarioFromYaml(const YAML::Node& root, const std::vector<std::string>& overrides = {});
 
 /// As loadScenarioFile(), from YAML text.
 Scenario parseScenario(const std::string& yaml_text,

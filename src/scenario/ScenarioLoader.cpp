@@ -264,6 +264,10 @@ Scenario parseRoot(YAML::Node root, const std::vector<std::string>& overrides) {
 
 }  // namespace
 
+Scenario scenarioFromYaml(const YAML::Node& root, const std::vector<std::string>& overrides) {
+  return parseRoot(YAML::Clone(root), overrides);
+}
+
 Scenario parseScenario(const std::string& yaml_text, const std::vector<std::string>& overrides) {
   YAML::Node root;
   try {

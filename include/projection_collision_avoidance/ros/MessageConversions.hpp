@@ -1,0 +1,63 @@
+#pragma once
+
+/// @file
+/// Conversions between the core's Eigen vectors and ROS messages, as free functions. Agents are
+/// double integrators in k = 1..3 axes: state [p; v], positions along x, y, z in that order.
+
+#include <geometry_msgs/AccelStamped.h>
+#include <geometry_msgs/TransformStamped.h>
+#include <nav_msgs/Odometry.h>
+#include <ros/time.h>
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "projection_collision_avoidance/LeaderBroadcast.h"
+#include "projection_collision_avoidance/RelativeMeasurement.h"
+
+namespace projection_collision_avoidance {
+
+/// A float64[] field as an Eigen vector.
+Eigen::VectorXd toEigen(const std::vector<double>& values);
+
+/// An Eigen vector as a float64[] field.
+std::vector<double> toStdVector(const Eigen::Ref<const Eigen::VectorXd>& values);
+
+/// The first min(k, 3) entries of @p values on x, y, z; the rest zero.
+Eigen::Vector3d toVector3(const Eigen::Ref<const Eigen::VectorXd>& values);
+
+/// Relative state x_1 - x_2 = [position; velocity] of a measurement with @p axes entries each.
+/// @return false, with the reason in @p why, for a wrong size or a non-finite entry
+bool relativeStateFromMsg(const RelativeMeasurement& msg, int axes, Eigen::VectorXd* state,
+                          std::string* why);
+
+/// A RelativeMeasurement of the relative state [position; velocity] (2 axes entries).
+RelativeMeasurement toRelativeMeasurementMsg(const Eigen::Ref<const Eigen::VectorXd>& state,
+                                             const ros::Time& stamp, const std::string& frame);
+
+/// The acceleration command (k entries) as AccelStamped (linear part; angular zero).
+geometry_msgs::AccelStamped toAccelMsg(const Eigen::Ref<const Eigen::VectorXd>& command,
+                                       const ros::Time& stamp, const std::string& frame);
+
+/// The first @p axes linear entries of an AccelStamped.
+/// @return false, with the reason in @p why, for a non-finite entry or a non-zero entry beyond
+///         the model's axes
+bool commandFromAccelMsg(const geometry_msgs::AccelStamped& msg, int axes,
+                         Eigen::VectorXd* command, std::string* why);
+
+/// Odometry of an agent's state [p; v] (2 axes entries): pose position and twist linear, identity
+/// orientation, in @p frame with child @p child_frame.
+nav_msgs::Odometry toOdometryMsg(const Eigen::Ref<const Eigen::VectorXd>& state,
+                                 const ros::Time& stamp, const std::string& frame,
+                                 const std::string& child_frame);
+
+/// The state [p; v] (2 axes entries) of an Odometry; false if non-finite.
+bool stateFromOdometryMsg(const nav_msgs::Odometry& msg, int axes, Eigen::VectorXd* state);
+
+/// The transform of a frame at @p position (1-3 entries) with identity rotation.
+geometry_msgs::TransformStamped toTransformMsg(const Eigen::Ref<const Eigen::VectorXd>& position,
+                                               const ros::Time& stamp, const std::string& parent,
+                                               const std::string& child);
+
+}  // namespace projection_collision_avoidance

@@ -1,0 +1,55 @@
+#pragma once
+
+/// @file
+/// Reading a node's private parameters: the scenario (the same YAML as cf_sim) and the node's
+/// own options. Every failure is a ParameterError whose key is the parameter's name
+/// ("~scenario/controller/alpha", "~measurement_timeout").
+
+#include <ros/node_handle.h>
+#include <xmlrpcpp/XmlRpcValue.h>
+#include <yaml-cpp/yaml.h>
+
+#include <string>
+#include <vector>
+
+#include "projection_collision_avoidance/Scenario.hpp"
+
+namespace projection_collision_avoidance {
+
+/// The same tree as YAML: structs become maps, arrays sequences, scalars scalars.
+YAML::Node toYaml(const XmlRpc::XmlRpcValue& value);
+
+/// Loads the scenario from the private parameter @p name: either a map (the scenario file loaded
+/// with `<rosparam command="load" file="..." ns="scenario"/>` inside the node) or a string, the
+/// path of a scenario file. Errors name "~<name>/<dotted/path>".
+Scenario loadScenarioParameter(const ros::NodeHandle& private_nh,
+                               const std::string& name = "scenario");
+
+/// Reads a node's own private options, checks each once, and remembers them for echo().
+class NodeOptionReader {
+ public:
+  explicit NodeOptionReader(const ros::NodeHandle& private_nh) : nh_(private_nh) {}
+
+  /// A number in [min, max]; @p fallback when absent. An int parameter is accepted.
+  double number(const std::string& key, double fallback, double min, double max);
+  /// A whole number in [min, max]; @p fallback when absent.
+  int integer(const std::string& key, int fallback, int min, int max);
+  bool boolean(const std::string& key, bool fallback);
+  std::string text(const std::string& key, const std::string& fallback);
+
+  /// Logs every option read, once, as "name: key = value" lines.
+  void echo(const std::string& node_name) const;
+
+ private:
+  bool lookup(const std::string& key, XmlRpc::XmlRpcValue* value) const;
+  void remember(const std::string& key, const std::string& value, bool defaulted);
+
+  ros::NodeHandle nh_;
+  std::vector<std::string> lines_;
+};
+
+/// Logs a scenario's loaded values once (its YAML, one line per entry) under @p node_name.
+void echoScenario(const std::string& node_name, const ros::NodeHandle& private_nh,
+                  const std::string& name = "scenario");
+
+}  // namespace projection_collision_avoidance

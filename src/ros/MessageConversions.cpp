@@ -1,0 +1,118 @@
+#include "projection_collision_avoidance/ros/MessageConversions.hpp"
+
+#include <tf2_eigen/tf2_eigen.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+
+namespace projection_collision_avoidance {
+
+Eigen::VectorXd toEigen(const std::vector<double>& values) {
+  return Eigen::Map<const Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size()));
+}
+
+std::vector<double> toStdVector(const Eigen::Ref<const Eigen::VectorXd>& values) {
+  return std::vector<double>(values.data(), values.data() + values.size());
+}
+
+Eigen::Vector3d toVector3(const Eigen::Ref<const Eigen::VectorXd>& values) {
+  Eigen::Vector3d result = Eigen::Vector3d::Zero();
+  const Eigen::Index count = std::min<Eigen::Index>(3, values.size());
+  result.head(count) = values.head(count);
+  return result;
+}
+
+bool relativeStateFromMsg(const RelativeMeasurement& msg, int axes, Eigen::VectorXd* state,
+                          std::string* why) {
+  if (static_cast<int>(msg.position.size()) != axes ||
+      static_cast<int>(msg.velocity.size()) != axes) {
+    *why = "position and velocity must have " + std::to_string(axes) + " entries, got " +
+           std::to_string(msg.position.size()) + " and " + std::to_string(msg.velocity.size());
+    return false;
+  }
+  Eigen::VectorXd result(2 * axes);
+  result << toEigen(msg.position), toEigen(msg.velocity);
+  if (!result.allFinite()) {
+    *why = "non-finite entry";
+    return false;
+  }
+  *state = result;
+  return true;
+}
+
+RelativeMeasurement toRelativeMeasurementMsg(const Eigen::Ref<const Eigen::VectorXd>& state,
+                                             const ros::Time& stamp, const std::string& frame) {
+  const Eigen::Index axes = state.size() / 2;
+  RelativeMeasurement msg;
+  msg.header.stamp = stamp;
+  msg.header.frame_id = frame;
+  msg.position = toStdVector(state.head(axes));
+  msg.velocity = toStdVector(state.tail(axes));
+  return msg;
+}
+
+geometry_msgs::AccelStamped toAccelMsg(const Eigen::Ref<const Eigen::VectorXd>& command,
+                                       const ros::Time& stamp, const std::string& frame) {
+  geometry_msgs::AccelStamped msg;
+  msg.header.stamp = stamp;
+  msg.header.frame_id = frame;
+  tf2::toMsg(toVector3(command), msg.accel.linear);
+  return msg;
+}
+
+bool commandFromAccelMsg(const geometry_msgs::AccelStamped& msg, int axes,
+                         Eigen::VectorXd* command, std::string* why) {
+  Eigen::Vector3d linear;
+  tf2::fromMsg(msg.accel.linear, linear);
+  if (!linear.allFinite()) {
+    *why = "non-finite acceleration";
+    return false;
+  }
+  if (!linear.tail(3 - axes).isZero()) {
+    *why = "acceleration on an axis the model does not have (" + std::to_string(axes) + " axes)";
+    return false;
+  }
+  *command = linear.head(axes);
+  return true;
+}
+
+nav_msgs::Odometry toOdometryMsg(const Eigen::Ref<const Eigen::VectorXd>& state,
+                                 const ros::Time& stamp, const std::string& frame,
+                                 const std::string& child_frame) {
+  const Eigen::Index axes = state.size() / 2;
+  nav_msgs::Odometry msg;
+  msg.header.stamp = stamp;
+  msg.header.frame_id = frame;
+  msg.child_frame_id = child_frame;
+  msg.pose.pose.position = tf2::toMsg(toVector3(state.head(axes)));
+  msg.pose.pose.orientation.w = 1.0;
+  tf2::toMsg(toVector3(state.tail(axes)), msg.twist.twist.linear);
+  return msg;
+}
+
+bool stateFromOdometryMsg(const nav_msgs::Odometry& msg, int axes, Eigen::VectorXd* state) {
+  Eigen::Vector3d position;
+  Eigen::Vector3d velocity;
+  tf2::fromMsg(msg.pose.pose.position, position);
+  tf2::fromMsg(msg.twist.twist.linear, velocity);
+  if (!position.allFinite() || !velocity.allFinite()) {
+    return false;
+  }
+  state->resize(2 * axes);
+  *state << position.head(axes), velocity.head(axes);
+  return true;
+}
+
+geometry_msgs::TransformStamped toTransformMsg(const Eigen::Ref<const Eigen::VectorXd>& position,
+                                               const ros::Time& stamp, const std::string& parent,
+                                               const std::string& child) {
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.translation() = toVector3(position);
+  geometry_msgs::TransformStamped msg = tf2::eigenToTransform(pose);
+  msg.header.stamp = stamp;
+  msg.header.frame_id = parent;
+  msg.child_frame_id = child;
+  return msg;
+}
+
+}  // namespace projection_collision_avoidance

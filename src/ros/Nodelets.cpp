@@ -1,0 +1,40 @@
+/// The three nodes as nodelets: each owns the same class the stand-alone node runs.
+
+#include <nodelet/nodelet.h>
+#include <pluginlib/class_list_macros.h>
+
+#include <memory>
+
+#include "projection_collision_avoidance/ParameterError.hpp"
+#include "projection_collision_avoidance/ros/FollowerNode.hpp"
+#include "projection_collision_avoidance/ros/LeaderNode.hpp"
+#include "projection_collision_avoidance/ros/PlantNode.hpp"
+
+namespace projection_collision_avoidance {
+
+/// Runs Node(node handle, private node handle) inside a nodelet manager. A refused parameter is
+/// logged with its key and fails the load (the manager's process is not ended).
+template <typename Node>
+class NodeletOf : public nodelet::Nodelet {
+ private:
+  void onInit() override {
+    try {
+      node_ = std::make_unique<Node>(getNodeHandle(), getPrivateNodeHandle());
+    } catch (const ParameterError& error) {
+      NODELET_FATAL_STREAM(getName() << ": invalid parameter " << error.what());
+      throw;
+    }
+  }
+
+  std::unique_ptr<Node> node_;
+};
+
+class FollowerNodelet : public NodeletOf<FollowerNode> {};
+class LeaderNodelet : public NodeletOf<LeaderNode> {};
+class PlantNodelet : public NodeletOf<PlantNode> {};
+
+}  // namespace projection_collision_avoidance
+
+PLUGINLIB_EXPORT_CLASS(projection_collision_avoidance::FollowerNodelet, nodelet::Nodelet)
+PLUGINLIB_EXPORT_CLASS(projection_collision_avoidance::LeaderNodelet, nodelet::Nodelet)
+PLUGINLIB_EXPORT_CLASS(projection_collision_avoidance::PlantNodelet, nodelet::Nodelet)

@@ -1,0 +1,193 @@
+#include "projection_collision_avoidance/ros/RosParameters.hpp"
+
+#include <ros/console.h>
+
+#include <algorithm>
+#include <sstream>
+
+#include "projection_collision_avoidance/ParameterError.hpp"
+#include "projection_collision_avoidance/ScenarioLoader.hpp"
+
+namespace projection_collision_avoidance {
+namespace {
+
+/// "controller.alpha" -> "~scenario/controller/alpha".
+std::string parameterName(const std::string& scenario_name, const std::string& dotted_key) {
+  std::string path = dotted_key;
+  std::replace(path.begin(), path.end(), '.', '/');
+  return "~" + scenario_name + (path.empty() || path[0] == '(' ? "" : "/" + path);
+}
+
+std::string typeName(const XmlRpc::XmlRpcValue& value) {
+  switch (value.getType()) {
+    case XmlRpc::XmlRpcValue::TypeBoolean:
+      return "a boolean";
+    case XmlRpc::XmlRpcValue::TypeInt:
+      return "an integer";
+    case XmlRpc::XmlRpcValue::TypeDouble:
+      return "a number";
+    case XmlRpc::XmlRpcValue::TypeString:
+      return "a string";
+    case XmlRpc::XmlRpcValue::TypeArray:
+      return "a list";
+    case XmlRpc::XmlRpcValue::TypeStruct:
+      return "a map";
+    default:
+      return "of another type";
+  }
+}
+
+}  // namespace
+
+YAML::Node toYaml(const XmlRpc::XmlRpcValue& value) {
+  XmlRpc::XmlRpcValue& v = const_cast<XmlRpc::XmlRpcValue&>(value);  // XmlRpc lacks const access
+  switch (v.getType()) {
+    case XmlRpc::XmlRpcValue::TypeBoolean:
+      return YAML::Node(static_cast<bool>(v));
+    case XmlRpc::XmlRpcValue::TypeInt:
+      return YAML::Node(static_cast<int>(v));
+    case XmlRpc::XmlRpcValue::TypeDouble:
+      return YAML::Node(static_cast<double>(v));
+    case XmlRpc::XmlRpcValue::TypeString:
+      return YAML::Node(static_cast<std::string>(v));
+    case XmlRpc::XmlRpcValue::TypeArray: {
+      YAML::Node sequence(YAML::NodeType::Sequence);
+      for (int i = 0; i < v.size(); ++i) {
+        sequence.push_back(toYaml(v[i]));
+      }
+      return sequence;
+    }
+    case XmlRpc::XmlRpcValue::TypeStruct: {
+      YAML::Node map(YAML::NodeType::Map);
+      for (auto& entry : v) {
+        map[entry.first] = toYaml(entry.second);
+      }
+      return map;
+    }
+    default:
+      return YAML::Node(YAML::NodeType::Null);
+  }
+}
+
+Scenario loadScenarioParameter(const ros::NodeHandle& private_nh, const std::string& name) {
+  XmlRpc::XmlRpcValue value;
+  if (!private_nh.getParam(name, value)) {
+    throw ParameterError("~" + name,
+                         "missing: load a scenario file into it (<rosparam command=\"load\" "
+                         "file=\"...\" ns=\"" + name + "\"/>) or give its path");
+  }
+  try {
+    if (value.getType() == XmlRpc::XmlRpcValue::TypeString) {
+      return loadScenarioFile(static_cast<std::string>(value));
+    }
+    if (value.getType() != XmlRpc::XmlRpcValue::TypeStruct) {
+      throw ParameterError("", "must be a map or a file path, got " + typeName(value));
+    }
+    return scenarioFromYaml(toYaml(value));
+  } catch (const ParameterError& error) {
+    throw ParameterError(parameterName(name, error.key()), error.reason());
+  }
+}
+
+bool NodeOptionReader::lookup(const std::string& key, XmlRpc::XmlRpcValue* value) const {
+  return nh_.getParam(key, *value);
+}
+
+void NodeOptionReader::remember(const std::string& key, const std::string& value, bool defaulted) {
+  lines_.push_back("~" + key + " = " + value + (defaulted ? " (default)" : ""));
+}
+
+double NodeOptionReader::number(const std::string& key, double fallback, double min, double max) {
+  XmlRpc::XmlRpcValue value;
+  double result = fallback;
+  const bool present = lookup(key, &value);
+  if (present) {
+    if (value.getType() == XmlRpc::XmlRpcValue::TypeDouble) {
+      result = static_cast<double>(value);
+    } else if (value.getType() == XmlRpc::XmlRpcValue::TypeInt) {
+      result = static_cast<int>(value);
+    } else {
+      throw ParameterError("~" + key, "must be a number, got " + typeName(value));
+    }
+  }
+  if (!(result >= min && result <= max)) {  // also refuses NaN
+    std::ostringstream reason;
+    reason << "must lie in [" << min << ", " << max << "], got " << result;
+    throw ParameterError("~" + key, reason.str());
+  }
+  std::ostringstream text;
+  text << result;
+  remember(key, text.str(), !present);
+  return result;
+}
+
+int NodeOptionReader::integer(const std::string& key, int fallback, int min, int max) {
+  XmlRpc::XmlRpcValue value;
+  int result = fallback;
+  const bool present = lookup(key, &value);
+  if (present) {
+    if (value.getType() != XmlRpc::XmlRpcValue::TypeInt) {
+      throw ParameterError("~" + key, "must be an integer, got " + typeName(value));
+    }
+    result = static_cast<int>(value);
+  }
+  if (result < min || result > max) {
+    throw ParameterError("~" + key, "must lie in [" + std::to_string(min) + ", " +
+                                        std::to_string(max) + "], got " + std::to_string(result));
+  }
+  remember(key, std::to_string(result), !present);
+  return result;
+}
+
+bool NodeOptionReader::boolean(const std::string& key, bool fallback) {
+  XmlRpc::XmlRpcValue value;
+  bool result = fallback;
+  const bool present = lookup(key, &value);
+  if (present) {
+    if (value.getType() != XmlRpc::XmlRpcValue::TypeBoolean) {
+      throw ParameterError("~" + key, "must be true or false, got " + typeName(value));
+    }
+    result = static_cast<bool>(value);
+  }
+  remember(key, result ? "true" : "false", !present);
+  return result;
+}
+
+std::string NodeOptionReader::text(const std::string& key, const std::string& fallback) {
+  XmlRpc::XmlRpcValue value;
+  std::string result = fallback;
+  const bool present = lookup(key, &value);
+  if (present) {
+    if (value.getType() != XmlRpc::XmlRpcValue::TypeString) {
+      throw ParameterError("~" + key, "must be a string, got " + typeName(value));
+    }
+    result = static_cast<std::string>(value);
+  }
+  remember(key, "'" + result + "'", !present);
+  return result;
+}
+
+void NodeOptionReader::echo(const std::string& node_name) const {
+  for (const std::string& line : lines_) {
+    ROS_INFO_STREAM(node_name << ": " << line);
+  }
+}
+
+void echoScenario(const std::string& node_name, const ros::NodeHandle& private_nh,
+                  const std::string& name) {
+  XmlRpc::XmlRpcValue value;
+  if (!private_nh.getParam(name, value)) {
+    return;
+  }
+  if (value.getType() == XmlRpc::XmlRpcValue::TypeString) {
+    ROS_INFO_STREAM(node_name << ": ~" << name << " = '" << static_cast<std::string>(value)
+                              << "' (scenario file)");
+    return;
+  }
+  std::istringstream lines(YAML::Dump(toYaml(value)));
+  for (std::string line; std::getline(lines, line);) {
+    ROS_INFO_STREAM(node_name << ": ~" << name << ": " << line);
+  }
+}
+
+}  // namespace projection_collision_avoidance
