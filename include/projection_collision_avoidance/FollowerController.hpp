@@ -9,7 +9,7 @@ namespace projection_collision_avoidance {
 
 /// Everything the follower computed at one control tick.
 template <typename Dims>
-struct FollowerStatus {
+struct FollowerControllerStatus {
   typename Dims::InputVector command;              ///< u_2 = baseline + tracker + feed-forward
   typename Dims::InputVector baseline_command;     ///< G y (2)
   typename Dims::InputVector tracker_command;      ///< u_a (19)
@@ -54,13 +54,13 @@ class FollowerController {
   /// One control period without leader information (u_1 taken as unknown).
   /// @param y relative measurement C (x_1 - x_2 - d), finite
   /// @return the status of this tick; status.command is u_2 (m/s^2 for double integrators)
-  const FollowerStatus<Dims>& step(const OutputVector& y) {
+  const FollowerControllerStatus<Dims>& step(const OutputVector& y) {
     return advance(y, InputVector::Zero(input_matrix_.cols()), false);
   }
 
   /// One control period with the leader's current input u_1 (used as configured by
   /// leader_input_in_command / leader_input_in_estimator).
-  const FollowerStatus<Dims>& step(const OutputVector& y, const InputVector& leader_input) {
+  const FollowerControllerStatus<Dims>& step(const OutputVector& y, const InputVector& leader_input) {
     return advance(y, leader_input, true);
   }
 
@@ -78,12 +78,12 @@ class FollowerController {
 
   /// The estimate that the next step will use (m).
   const StateVector& estimate() const { return estimator_.estimate(); }
-  const FollowerStatus<Dims>& status() const { return status_; }
+  const FollowerControllerStatus<Dims>& status() const { return status_; }
   const ControllerDesign& design() const { return design_; }
   const CollisionFreeEstimator<Dims>& estimator() const { return estimator_; }
 
  private:
-  const FollowerStatus<Dims>& advance(const OutputVector& y, const InputVector& leader_input,
+  const FollowerControllerStatus<Dims>& advance(const OutputVector& y, const InputVector& leader_input,
                                       bool leader_input_known) {
     const ControllerParameters& p = design_.parameters;
     if (!initialized_) {
@@ -127,7 +127,7 @@ class FollowerController {
   typename Dims::OutputMatrix output_matrix_;               // C
   typename Dims::FeedbackGainMatrix baseline_gain_;         // G
   typename Dims::ObserverGainMatrix output_pseudoinverse_;  // pinv(C)
-  FollowerStatus<Dims> status_;
+  FollowerControllerStatus<Dims> status_;
   bool initialized_ = false;
 };
 

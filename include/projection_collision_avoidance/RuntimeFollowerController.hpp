@@ -9,7 +9,7 @@
 
 namespace projection_collision_avoidance {
 
-/// FollowerStatus with run-time sized vectors, for callers that learn the model's sizes from
+/// FollowerControllerStatus with run-time sized vectors, for callers that learn the model's sizes from
 /// configuration (the ROS nodes). The vectors are sized once; a step only overwrites them.
 struct RuntimeFollowerStatus {
   Eigen::VectorXd command;              ///< u_2

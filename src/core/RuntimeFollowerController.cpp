@@ -9,7 +9,7 @@ namespace projection_collision_avoidance {
 namespace {
 
 template <typename Dims>
-void copyStatus(const FollowerStatus<Dims>& from, RuntimeFollowerStatus* to) {
+void copyStatus(const FollowerControllerStatus<Dims>& from, RuntimeFollowerStatus* to) {
   to->command = from.command;
   to->baseline_command = from.baseline_command;
   to->tracker_command = from.tracker_command;

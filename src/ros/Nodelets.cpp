@@ -1,7 +1,7 @@
 /// The three nodes as nodelets: each owns the same class the stand-alone node runs.
 
 #include <nodelet/nodelet.h>
-#include <pluginlib/class_list_macros.h>
+#include <pluginlib/class_list_macros.hpp>
 
 #include <memory>
 
