@@ -11,6 +11,10 @@ packages=(
   libeigen3-dev libyaml-cpp-dev
   googletest libgtest-dev libbenchmark-dev
   python3-yaml python3-numpy python3-scipy python3-matplotlib
+  ros-core-dev libtf2-ros-dev libtf2-eigen-dev libdiagnostic-updater-dev
+  libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure
+  libnodeletlib-dev libnodeletlib-tools pluginlib-dev
+  python3-rostest python3-rosbag librosbag-dev rviz xvfb
 )
 if [[ "${1:-}" == "--workspace-tools" ]]; then
   packages+=(catkin-tools colcon python3-colcon-ros)

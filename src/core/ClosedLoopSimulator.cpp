@@ -6,17 +6,17 @@
 #include <locale>
 #include <sstream>
 #include <string>
-#include <vector>
 
+#include "projection_collision_avoidance/AgentIntegrator.hpp"
 #include "projection_collision_avoidance/ControllerDesign.hpp"
 #include "projection_collision_avoidance/DimensionDispatch.hpp"
-#include "projection_collision_avoidance/ExactDiscretization.hpp"
 #include "projection_collision_avoidance/FollowerController.hpp"
 
 namespace projection_collision_avoidance {
 namespace {
 
-/// Both agents of the run, integrated exactly with their inputs held over each step.
+/// Both agents of the run, each integrated exactly with its input held over each period; the
+/// leader also under the disturbance u_d (applied exactly, the period split at its pulse edges).
 template <typename Dims>
 class TwoAgentPlant {
  public:
@@ -24,69 +24,22 @@ class TwoAgentPlant {
   using InputVector = typename Dims::InputVector;
 
   TwoAgentPlant(const Scenario& scenario, double period)
-      : model_(scenario.controller.model),
-        disturbance_(scenario.disturbance),
-        period_(period),
-        input_matrix_(scenario.controller.model.B),
-        leader_(scenario.leader_initial_state),
-        follower_(scenario.follower_initial_state) {
-    const ExactDiscretization nominal = ExactDiscretization::compute(model_.A, period);
-    transition_ = nominal.transition;
-    integral_ = nominal.integral;
-  }
+      : leader_(scenario.controller.model, period, scenario.leader_initial_state,
+                scenario.disturbance),
+        follower_(scenario.controller.model, period, scenario.follower_initial_state) {}
 
-  const StateVector& leader() const { return leader_; }
-  const StateVector& follower() const { return follower_; }
+  const StateVector& leader() const { return leader_.state(); }
+  const StateVector& follower() const { return follower_.state(); }
 
   /// Integrates both agents from t to t + period with u_1, u_2 held and u_d exact.
   void advance(double t, const InputVector& leader_input, const InputVector& follower_input) {
-    const StateVector leader_drive = input_matrix_ * leader_input;
-    const StateVector follower_drive = input_matrix_ * follower_input;
-    // Split the step at the disturbance's pulse edges; evaluate u_d mid-segment so that an
-    // edge that rounding puts a hair away from a tick does not flip the pulse's state.
-    const double t_end = t + period_;
-    const double tolerance = 1e-9 * period_;
-    const std::vector<double> edges = disturbance_.edgesWithin(t + tolerance, t_end - tolerance);
-    if (edges.empty()) {
-      advanceSegment(t, t_end, transition_, integral_, leader_drive, follower_drive);
-      return;
-    }
-    double a = t;
-    for (const double edge : edges) {
-      advanceSplit(a, edge, leader_drive, follower_drive);
-      a = edge;
-    }
-    advanceSplit(a, t_end, leader_drive, follower_drive);
+    leader_.advance(t, leader_input);
+    follower_.advance(t, follower_input);
   }
 
  private:
-  /// Integrates over [a, b] with the discretisation (Phi, Psi) of that interval.
-  template <typename Matrix>
-  void advanceSegment(double a, double b, const Matrix& transition, const Matrix& integral,
-                      const StateVector& leader_drive, const StateVector& follower_drive) {
-    StateVector w = leader_drive;
-    if (!disturbance_.pulses.empty()) {
-      w += disturbance_.value(0.5 * (a + b), model_.stateDimension());
-    }
-    leader_ = transition * leader_ + integral * w;
-    follower_ = transition * follower_ + integral * follower_drive;
-  }
-
-  /// A part of a period cut at a pulse edge: discretised for its own length.
-  void advanceSplit(double a, double b, const StateVector& leader_drive,
-                    const StateVector& follower_drive) {
-    const ExactDiscretization segment = ExactDiscretization::compute(model_.A, b - a);
-    advanceSegment(a, b, segment.transition, segment.integral, leader_drive, follower_drive);
-  }
-
-  const AgentModel& model_;
-  const SignalProfile& disturbance_;
-  double period_;
-  typename Dims::StateMatrix transition_;    // Phi over one period
-  typename Dims::StateMatrix integral_;      // Psi over one period
-  typename Dims::InputMatrix input_matrix_;  // B
-  StateVector leader_;
-  StateVector follower_;
+  AgentIntegrator<Dims> leader_;
+  AgentIntegrator<Dims> follower_;
 };
 
 template <typename Dims>

@@ -1,0 +1,109 @@
+#include "projection_collision_avoidance/ros/LeaderNode.hpp"
+
+#include <geometry_msgs/AccelStamped.h>
+
+#include "projection_collision_avoidance/LeaderBroadcast.h"
+#include "projection_collision_avoidance/ParameterError.hpp"
+#include "projection_collision_avoidance/ros/MessageConversions.hpp"
+#include "projection_collision_avoidance/ros/RosParameters.hpp"
+
+namespace projection_collision_avoidance {
+namespace {
+
+/// The scenario in ~scenario; the ROS nodes run double integrators only.
+Scenario loadLeaderScenario(const ros::NodeHandle& private_nh) {
+  Scenario scenario = loadScenarioParameter(private_nh);
+  if (!scenario.controller.model.isDoubleIntegrator()) {
+    throw ParameterError("~scenario/model/type",
+                         "the ROS nodes run double_integrator models only; use cf_sim for a "
+                         "linear model");
+  }
+  return scenario;
+}
+
+LeaderNodeOptions readOptions(NodeOptionReader& reader, const Scenario& scenario) {
+  LeaderNodeOptions o;
+  o.rate = reader.number("rate", scenario.controller.control_rate, 1.0, 10000.0);
+  o.leader_frame = reader.text("leader_frame", o.leader_frame);
+  if (o.leader_frame.empty()) {
+    throw ParameterError("~leader_frame", "must not be empty");
+  }
+  o.share_disturbance = reader.boolean("share_disturbance", o.share_disturbance);
+  return o;
+}
+
+}  // namespace
+
+LeaderNode::LeaderNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
+    : nh_(nh),
+      name_(ros::this_node::getName()),
+      scenario_(loadLeaderScenario(private_nh)),
+      axes_(scenario_.controller.model.double_integrator_axes) {
+  NodeOptionReader reader(private_nh);
+  options_ = readOptions(reader, scenario_);
+  echoScenario(name_, private_nh);
+  reader.echo(name_);
+
+  command_publisher_ = nh_.advertise<geometry_msgs::AccelStamped>("leader/command", 10);
+  broadcast_publisher_ = nh_.advertise<LeaderBroadcast>("leader/broadcast", 10);
+  odometry_subscriber_ = nh_.subscribe("leader/odom", 10, &LeaderNode::onOdometry, this,
+                                       ros::TransportHints().tcpNoDelay());
+  timer_ = nh_.createTimer(ros::Duration(1.0 / options_.rate), &LeaderNode::onTick, this);
+  ROS_INFO_STREAM(name_ << ": playing the leader's input at " << options_.rate << " Hz, " << axes_
+                        << " axes, " << scenario_.leader_input.pulses.size() << " pulse(s) and "
+                        << scenario_.leader_input.sinusoids.size() << " sinusoid(s); disturbance "
+                        << (options_.share_disturbance ? "shared" : "not shared"));
+}
+
+void LeaderNode::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  Eigen::VectorXd state;
+  if (!stateFromOdometryMsg(*msg, axes_, &state)) {
+    ++rejected_odometry_;
+    ROS_WARN_STREAM_THROTTLE(5.0, name_ << ": leader/odom rejected (" << rejected_odometry_
+                                        << " so far): non-finite position or velocity");
+    return;
+  }
+  odometry_ = *msg;
+  state_ = state;
+  have_odometry_ = true;
+}
+
+void LeaderNode::onTick(const ros::TimerEvent& event) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  // The tick's time: the ROS time at which it runs. (current_expected can lag far behind after a
+  // jump of ROS time, such as the first /clock; under sim time a timer also polls only every
+  // wall millisecond, so it skips ticks when simulated time runs faster than 1 / rate per ms.)
+  const ros::Time stamp = event.current_real;
+  if (stamp.isZero() || (started_ && stamp == last_stamp_)) {
+    return;
+  }
+  if (started_ && stamp < last_stamp_) {
+    // A restarted /clock, say: follow it, and forget the odometry of the old time line.
+    ROS_WARN_STREAM(name_ << ": ROS time went back from " << last_stamp_.toSec() << " s to "
+                          << stamp.toSec() << " s");
+    have_odometry_ = false;
+  }
+  last_stamp_ = stamp;
+  if (!started_) {
+    started_ = true;
+    origin_ = ros::Time::isSimTime() ? ros::Time(0) : stamp;
+  }
+  const double t = (stamp - origin_).toSec();
+  const Eigen::VectorXd input = scenario_.leader_input.value(t, axes_);
+  command_publisher_.publish(toAccelMsg(input, stamp, options_.leader_frame));
+  if (!have_odometry_) {
+    return;
+  }
+  LeaderBroadcast broadcast;
+  broadcast.header = odometry_.header;
+  broadcast.position = toStdVector(state_.head(axes_));
+  broadcast.velocity = toStdVector(state_.tail(axes_));
+  broadcast.input = toStdVector(input);
+  if (options_.share_disturbance) {
+    broadcast.disturbance = toStdVector(scenario_.disturbance.value(t, 2 * axes_));
+  }
+  broadcast_publisher_.publish(broadcast);
+}
+
+}  // namespace projection_collision_avoidance

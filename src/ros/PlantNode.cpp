@@ -1,0 +1,432 @@
+#include "projection_collision_avoidance/ros/PlantNode.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <utility>
+
+#include <geometry_msgs/TransformStamped.h>
+#include <nav_msgs/Odometry.h>
+#include <rosgraph_msgs/Clock.h>
+#include <visualization_msgs/MarkerArray.h>
+
+#include "projection_collision_avoidance/ParameterError.hpp"
+#include "projection_collision_avoidance/ros/MessageConversions.hpp"
+
+namespace projection_collision_avoidance {
+namespace {
+
+/// Markers are published at most this often (Hz of simulated time).
+constexpr double kMarkerRate = 20.0;
+/// A tick is due when the time is within this fraction of a period of it.
+constexpr double kTickTolerance = 1e-6;
+/// Wall seconds of ticks that one wall-timer callback may catch up.
+constexpr double kMaxCatchUp = 0.05;
+/// Wall seconds between the last tick's messages and the shutdown, to let them out.
+constexpr double kShutdownDelay = 0.25;
+
+/// The scenario in ~scenario; the plant simulates double integrators only.
+Scenario loadPlantScenario(const ros::NodeHandle& private_nh) {
+  Scenario scenario = loadScenarioParameter(private_nh);
+  if (!scenario.controller.model.isDoubleIntegrator()) {
+    throw ParameterError("~scenario/model/type",
+                         "the plant simulates double_integrator models only; use cf_sim for a "
+                         "linear model");
+  }
+  return scenario;
+}
+
+std::string frameParameter(NodeOptionReader& reader, const std::string& key,
+                           const std::string& fallback) {
+  const std::string frame = reader.text(key, fallback);
+  if (frame.empty()) {
+    throw ParameterError("~" + key, "must not be empty");
+  }
+  return frame;
+}
+
+PlantNodeOptions readOptions(NodeOptionReader& reader, const Scenario& scenario) {
+  PlantNodeOptions o;
+  o.rate = reader.number("rate", scenario.controller.control_rate, 1.0, 10000.0);
+  o.world_frame = frameParameter(reader, "world_frame", o.world_frame);
+  o.leader_frame = frameParameter(reader, "leader_frame", o.leader_frame);
+  o.follower_frame = frameParameter(reader, "follower_frame", o.follower_frame);
+  if (o.leader_frame == o.world_frame || o.follower_frame == o.world_frame) {
+    throw ParameterError(o.leader_frame == o.world_frame ? "~leader_frame" : "~follower_frame",
+                         "must differ from ~world_frame '" + o.world_frame + "'");
+  }
+  if (o.follower_frame == o.leader_frame) {
+    throw ParameterError("~follower_frame",
+                         "must differ from ~leader_frame '" + o.leader_frame + "'");
+  }
+  o.noise_position = reader.number("measurement_noise_position", 0.0, 0.0, 1000.0);
+  o.noise_velocity = reader.number("measurement_noise_velocity", 0.0, 0.0, 1000.0);
+  o.dropout = reader.number("measurement_dropout", 0.0, 0.0, 1.0);
+  if (o.dropout >= 1.0) {
+    throw ParameterError("~measurement_dropout", "must lie in [0, 1), got 1");
+  }
+  o.latency = reader.number("measurement_latency", 0.0, 0.0, 1.0);
+  o.noise_seed = reader.integer("noise_seed", 1, 0, std::numeric_limits<int>::max());
+  o.command_timeout = reader.number("command_timeout", o.command_timeout, 0.0, 3600.0);
+  if (o.command_timeout <= 0.0) {
+    throw ParameterError("~command_timeout", "must be > 0, got 0");
+  }
+  o.publish_clock = reader.boolean("publish_clock", false);
+  o.real_time_factor = reader.number("real_time_factor", 1.0, 0.0, 1000.0);
+  if (o.real_time_factor <= 0.0) {
+    throw ParameterError("~real_time_factor", "must lie in (0, 1000], got 0");
+  }
+  o.duration = reader.number("duration", 0.0, 0.0, 1e7);
+  return o;
+}
+
+visualization_msgs::Marker agentMarker(const std::string& frame, const ros::Time& stamp,
+                                       const std::string& ns, int id, int type, double size,
+                                       float r, float g, float b) {
+  visualization_msgs::Marker marker;
+  marker.header.frame_id = frame;
+  marker.header.stamp = stamp;
+  marker.ns = ns;
+  marker.id = id;
+  marker.type = type;
+  marker.action = visualization_msgs::Marker::ADD;
+  marker.pose.orientation.w = 1.0;
+  marker.scale.x = marker.scale.y = marker.scale.z = size;
+  marker.color.r = r;
+  marker.color.g = g;
+  marker.color.b = b;
+  marker.color.a = 1.0F;
+  marker.frame_locked = true;  // follows its tf frame between marker updates
+  return marker;
+}
+
+visualization_msgs::Marker labelMarker(const std::string& frame, const ros::Time& stamp, int id,
+                                       const std::string& text, double height) {
+  visualization_msgs::Marker marker = agentMarker(
+      frame, stamp, "labels", id, visualization_msgs::Marker::TEXT_VIEW_FACING, 0.3, 1, 1, 1);
+  marker.scale.x = marker.scale.y = 0.0;
+  marker.pose.position.z = height;
+  marker.text = text;
+  return marker;
+}
+
+}  // namespace
+
+PlantNode::Agent::Agent(const std::string& agent_name, const std::string& tf_frame,
+                        const AgentModel& model, double step, const Eigen::VectorXd& initial_state,
+                        const SignalProfile& disturbance)
+    : name(agent_name),
+      frame(tf_frame),
+      integrator(model, step, initial_state, disturbance),
+      command(Eigen::VectorXd::Zero(model.inputDimension())) {}
+
+PlantNode::PlantNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
+    : nh_(nh),
+      name_(ros::this_node::getName()),
+      scenario_(loadPlantScenario(private_nh)),
+      reader_(private_nh),
+      options_(readOptions(reader_, scenario_)),
+      axes_(scenario_.controller.model.double_integrator_axes),
+      leader_("leader", options_.leader_frame, scenario_.controller.model, 1.0 / options_.rate,
+              scenario_.leader_initial_state, scenario_.disturbance),
+      rng_(static_cast<std::mt19937::result_type>(options_.noise_seed)) {
+  echoScenario(name_, private_nh);
+  reader_.echo(name_);
+
+  // The follower list: one follower for now. Subscriptions hold pointers into it, so it is
+  // complete before any is made.
+  followers_.push_back(
+      Follower{Agent("follower", options_.follower_frame, scenario_.controller.model,
+                     1.0 / options_.rate, scenario_.follower_initial_state, SignalProfile{}),
+               {},
+               {},
+               0});
+  leader_.odom_publisher = nh_.advertise<nav_msgs::Odometry>("leader/odom", 10);
+  leader_.command_subscriber = nh_.subscribe<geometry_msgs::AccelStamped>(
+      "leader/command", 10,
+      [this](const geometry_msgs::AccelStamped::ConstPtr& msg) { onCommand(&leader_, msg); },
+      ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
+  for (Follower& follower : followers_) {
+    Agent* agent = &follower.agent;
+    agent->odom_publisher = nh_.advertise<nav_msgs::Odometry>(agent->name + "/odom", 10);
+    follower.measurement_publisher =
+        nh_.advertise<RelativeMeasurement>(agent->name + "/relative_measurement", 10);
+    agent->command_subscriber = nh_.subscribe<geometry_msgs::AccelStamped>(
+        agent->name + "/command", 10,
+        [this, agent](const geometry_msgs::AccelStamped::ConstPtr& msg) { onCommand(agent, msg); },
+        ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
+  }
+  marker_publisher_ = nh_.advertise<visualization_msgs::MarkerArray>("agent_markers", 2);
+  ticks_per_marker_ = std::max(1L, static_cast<long>(std::ceil(options_.rate / kMarkerRate)));
+  if (options_.duration > 0.0) {
+    last_tick_ = std::lround(options_.duration * options_.rate);
+  }
+
+  if (options_.publish_clock) {
+    // The plant owns simulated time: it must not wait on ROS time (which stays 0 under
+    // use_sim_time until a /clock arrives), so it ticks on wall time and publishes /clock.
+    if (!ros::Time::isSimTime()) {
+      ROS_WARN_STREAM(name_ << ": ~publish_clock is set but /use_sim_time is not: the other "
+                               "nodes will ignore /clock");
+    }
+    clock_publisher_ = nh_.advertise<rosgraph_msgs::Clock>("/clock", 10);
+    started_ = true;
+    origin_ = ros::Time(0);
+    wall_origin_ = ros::WallTime::now();
+    rate_check_wall_ = wall_origin_;
+    wall_timer_ =
+        nh_.createWallTimer(ros::WallDuration(1.0 / (options_.rate * options_.real_time_factor)),
+                            &PlantNode::onWallTick, this);
+  } else {
+    timer_ = nh_.createTimer(ros::Duration(1.0 / options_.rate), &PlantNode::onRosTick, this);
+  }
+  std::ostringstream summary;
+  summary << name_ << ": simulating a leader and " << followers_.size() << " follower(s), " << axes_
+          << " axes, at " << options_.rate << " Hz";
+  if (options_.publish_clock) {
+    summary << ", publishing /clock at " << options_.real_time_factor << "x real time";
+  } else {
+    summary << " on ROS time";
+  }
+  if (options_.duration > 0.0) {
+    summary << ", for " << options_.duration << " s";
+  }
+  ROS_INFO_STREAM(summary.str());
+}
+
+void PlantNode::onCommand(Agent* agent, const geometry_msgs::AccelStamped::ConstPtr& msg) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  std::string why;
+  Eigen::VectorXd command;
+  bool valid = commandFromAccelMsg(*msg, axes_, &command, &why);
+  std::string kind = why;  // what repeats of one rejection have in common
+  // A command stamped ahead of the plant's time would never time out: its sender's clock is not
+  // the plant's (a wall-time stamp under simulated time, say).
+  const ros::Time now = started_ ? stampOf(std::max(0L, next_tick_ - 1)) : ros::Time::now();
+  if (valid && (msg->header.stamp - now).toSec() > options_.command_timeout) {
+    std::ostringstream reason;
+    reason << "stamped " << msg->header.stamp.toSec() << " s, more than ~command_timeout after "
+           << "the plant's time " << now.toSec() << " s (another clock?)";
+    why = reason.str();
+    kind = "stamped in the future";
+    valid = false;
+  }
+  if (!valid) {
+    ++agent->rejected_commands;
+    if (kind != agent->last_rejection) {
+      ROS_WARN_STREAM(name_ << ": " << agent->name << "/command rejected: " << why);
+      agent->last_rejection = kind;
+    } else {
+      ROS_WARN_STREAM_THROTTLE(5.0, name_ << ": " << agent->name << "/command rejected ("
+                                          << agent->rejected_commands << " so far): " << why);
+    }
+    return;
+  }
+  agent->last_rejection.clear();
+  if (!agent->have_command) {
+    ROS_INFO_STREAM(name_ << ": first " << agent->name << "/command received");
+  }
+  agent->command = command;
+  agent->command_stamp = msg->header.stamp;
+  agent->have_command = true;
+}
+
+ros::Time PlantNode::stampOf(long k) const {
+  const double offset_ns = static_cast<double>(k) * 1e9 / options_.rate;
+  ros::Time stamp;
+  stamp.fromNSec(origin_.toNSec() + static_cast<uint64_t>(std::llround(offset_ns)));
+  return stamp;
+}
+
+void PlantNode::onWallTick(const ros::WallTimerEvent& /*event*/) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  if (!running_) {
+    return;
+  }
+  // Tick k is due at wall time wall_origin_ + k / (rate * real_time_factor). A callback that
+  // runs late catches up the ticks due since (at most kMaxCatchUp s of them at once), so that
+  // simulated time keeps the real-time factor on average; a backlog beyond that is dropped
+  // (simulated time slows down) and reported below.
+  const double wall_rate = options_.rate * options_.real_time_factor;
+  const ros::WallTime now = ros::WallTime::now();
+  long due =
+      static_cast<long>(std::floor((now - wall_origin_).toSec() * wall_rate + kTickTolerance));
+  const long max_catch_up = std::max(1L, std::lround(kMaxCatchUp * wall_rate));
+  if (due - next_tick_ >= max_catch_up) {
+    due = next_tick_;
+    wall_origin_ = now - ros::WallDuration(static_cast<double>(next_tick_) / wall_rate);
+  }
+  while (running_ && next_tick_ <= due) {
+    running_ = tick(next_tick_);
+    ++next_tick_;
+  }
+  // Report, at most every 5 s, a simulation slower than the real-time factor asked for.
+  const double wall = (now - rate_check_wall_).toSec();
+  if (wall >= 5.0) {
+    const double factor = static_cast<double>(next_tick_ - rate_check_tick_) / options_.rate / wall;
+    if (factor < 0.9 * options_.real_time_factor) {
+      ROS_WARN_STREAM(name_ << ": simulating at " << factor << "x real time, below the "
+                            << options_.real_time_factor << "x asked for");
+    }
+    rate_check_wall_ = now;
+    rate_check_tick_ = next_tick_;
+  }
+}
+
+void PlantNode::onRosTick(const ros::TimerEvent& /*event*/) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  const ros::Time now = ros::Time::now();
+  if (!running_ || now.isZero()) {
+    return;
+  }
+  if (!started_) {
+    // Under use_sim_time scenario time is ROS time; otherwise it starts at the first tick.
+    started_ = true;
+    origin_ = ros::Time::isSimTime() ? ros::Time(0) : now;
+    next_tick_ =
+        static_cast<long>(std::ceil((now - origin_).toSec() * options_.rate - kTickTolerance));
+    if (last_tick_ >= 0 && next_tick_ > last_tick_) {
+      std::ostringstream why;
+      why << "ROS time " << now.toSec() << " s is already past ~duration = " << options_.duration
+          << " s";
+      stop(why.str());
+      return;
+    }
+  }
+  const long due =
+      static_cast<long>(std::floor((now - origin_).toSec() * options_.rate + kTickTolerance));
+  if (due < next_tick_ - 1) {
+    ROS_WARN_STREAM_THROTTLE(5.0, name_ << ": ROS time went back to " << now.toSec()
+                                        << " s; waiting for it to reach "
+                                        << stampOf(next_tick_).toSec() << " s again");
+    return;
+  }
+  // Catch up every due tick, at most one second of them per call.
+  const long limit = next_tick_ + std::max(1L, std::lround(options_.rate));
+  while (running_ && next_tick_ <= std::min(due, limit)) {
+    running_ = tick(next_tick_);
+    ++next_tick_;
+  }
+}
+
+bool PlantNode::tick(long k) {
+  const double t = static_cast<double>(k) / options_.rate;
+  const ros::Time stamp = stampOf(k);
+
+  // Sample: odometry, tf, relative measurements.
+  const Eigen::VectorXd leader_state = leader_.integrator.state();
+  std::vector<geometry_msgs::TransformStamped> transforms;
+  transforms.reserve(1 + followers_.size());
+  leader_.odom_publisher.publish(
+      toOdometryMsg(leader_state, stamp, options_.world_frame, leader_.frame));
+  transforms.push_back(
+      toTransformMsg(leader_state.head(axes_), stamp, options_.world_frame, leader_.frame));
+  for (Follower& follower : followers_) {
+    const Eigen::VectorXd state = follower.agent.integrator.state();
+    follower.agent.odom_publisher.publish(
+        toOdometryMsg(state, stamp, options_.world_frame, follower.agent.frame));
+    transforms.push_back(
+        toTransformMsg(state.head(axes_), stamp, options_.world_frame, follower.agent.frame));
+    publishMeasurement(&follower, k, stamp);
+  }
+  tf_broadcaster_.sendTransform(transforms);
+  if (k % ticks_per_marker_ == 0) {
+    publishMarkers(stamp);
+  }
+  if (options_.publish_clock) {
+    rosgraph_msgs::Clock clock;
+    clock.clock = stamp;
+    clock_publisher_.publish(clock);
+  }
+  if (last_tick_ >= 0 && k >= last_tick_) {
+    std::ostringstream why;
+    why << "simulated time reached ~duration = " << options_.duration << " s";
+    stop(why.str());
+    return false;
+  }
+
+  // Integrate every agent to t_{k+1} with its command held; the leader under u_d.
+  leader_.integrator.advance(t, commandAt(&leader_, stamp));
+  for (Follower& follower : followers_) {
+    follower.agent.integrator.advance(t, commandAt(&follower.agent, stamp));
+  }
+  return true;
+}
+
+void PlantNode::publishMeasurement(Follower* follower, long k, const ros::Time& stamp) {
+  // Draw every random number every tick, so the noise sequence does not depend on dropouts.
+  Eigen::VectorXd noise(2 * axes_);
+  for (int i = 0; i < 2 * axes_; ++i) {
+    noise(i) = normal_(rng_) * (i < axes_ ? options_.noise_position : options_.noise_velocity);
+  }
+  const bool dropped = uniform_(rng_) < options_.dropout;
+  if (dropped) {
+    ++follower->dropped;
+  } else {
+    const Eigen::VectorXd relative =
+        leader_.integrator.state() - follower->agent.integrator.state() + noise;
+    follower->pending.push_back(toRelativeMeasurementMsg(relative, stamp, options_.world_frame));
+  }
+  // Publish what was sampled at least `latency` ago (in ticks, t_k - t_j >= latency).
+  const double latency_ticks = options_.latency * options_.rate;
+  while (!follower->pending.empty()) {
+    const RelativeMeasurement& oldest = follower->pending.front();
+    const double sampled_tick = (oldest.header.stamp - origin_).toSec() * options_.rate;
+    if (static_cast<double>(k) - sampled_tick < latency_ticks - kTickTolerance) {
+      break;
+    }
+    follower->measurement_publisher.publish(oldest);
+    follower->pending.pop_front();
+  }
+}
+
+void PlantNode::publishMarkers(const ros::Time& stamp) {
+  using visualization_msgs::Marker;
+  visualization_msgs::MarkerArray markers;
+  markers.markers.push_back(
+      agentMarker(leader_.frame, stamp, "agents", 0, Marker::CUBE, 0.6, 0.1F, 0.3F, 1.0F));
+  markers.markers.push_back(labelMarker(leader_.frame, stamp, 0, leader_.name, 0.7));
+  int id = 1;
+  for (const Follower& follower : followers_) {
+    markers.markers.push_back(agentMarker(follower.agent.frame, stamp, "agents", id, Marker::SPHERE,
+                                          0.5, 1.0F, 0.55F, 0.0F));
+    markers.markers.push_back(
+        labelMarker(follower.agent.frame, stamp, id, follower.agent.name, 0.6));
+    ++id;
+  }
+  marker_publisher_.publish(markers);
+}
+
+GenericDimensions::InputVector PlantNode::commandAt(Agent* agent, const ros::Time& now) {
+  const bool fresh = agent->have_command &&
+                     std::abs((now - agent->command_stamp).toSec()) <= options_.command_timeout;
+  if (fresh) {
+    if (agent->command_timed_out) {
+      ROS_INFO_STREAM(name_ << ": " << agent->name << "/command fresh again");
+      agent->command_timed_out = false;
+    }
+    return agent->command;
+  }
+  if (agent->have_command && !agent->command_timed_out) {
+    ROS_WARN_STREAM(name_ << ": " << agent->name << "/command stamped "
+                          << agent->command_stamp.toSec() << " s is older than ~command_timeout ("
+                          << options_.command_timeout << " s) at " << now.toSec()
+                          << " s: using zero");
+    agent->command_timed_out = true;
+  }
+  return GenericDimensions::InputVector::Zero(axes_);
+}
+
+void PlantNode::stop(const std::string& why) {
+  ROS_INFO_STREAM(name_ << ": " << why << "; shutting down");
+  running_ = false;
+  wall_timer_.stop();
+  timer_.stop();
+  // Shut down a moment later (wall time), so that the last tick's messages reach subscribers.
+  shutdown_timer_ = nh_.createWallTimer(
+      ros::WallDuration(kShutdownDelay), [](const ros::WallTimerEvent&) { ros::requestShutdown(); },
+      true);
+}
+
+}  // namespace projection_collision_avoidance
