@@ -1,0 +1,59 @@
+/// rostest: a paper run through the ROS graph on simulated time, against cf_sim's figures for the
+/// same scenario. Parameters (<param>s of the test node):
+///   ~scenario          the scenario, loaded as the nodes load it
+///   ~expect_inside     true: ||xi|| stays within xi_max and the separation outside the perimeter;
+///                      false: the bound is left while ||xi_hat|| <= xi_max holds
+///   ~end_time          simulated seconds to observe
+///   ~tolerance         largest difference to cf_sim of max ||xi|| and min separation (m)
+///   ~wall_deadline     wall seconds to wait for end_time
+
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+
+#include "projection_collision_avoidance/ClosedLoopSimulator.hpp"
+#include "projection_collision_avoidance/ControllerDesign.hpp"
+#include "projection_collision_avoidance/ros/RosParameters.hpp"
+#include "test_common.h"
+
+namespace projection_collision_avoidance {
+namespace {
+
+using testing::FollowerTest;
+
+TEST_F(FollowerTest, PaperRunThroughTheRosGraph) {
+  Scenario scenario = loadScenarioParameter(private_nh_);
+  const double end_time = param("end_time");
+  const double tolerance = param("tolerance");
+  bool expect_inside = true;
+  ASSERT_TRUE(private_nh_.getParam("expect_inside", expect_inside));
+  scenario.duration = end_time;
+  const SimulationSummary expected = simulate(scenario);
+  const ControllerDesign design = ControllerDesign::create(scenario.controller);
+
+  ASSERT_TRUE(waitForStatusTime(end_time, param("wall_deadline")))
+      << "no status at t >= " << end_time << " s; last " << record().last_time << " s";
+  const testing::StatusRecord r = record();
+  ROS_INFO("ROS run: max |xi| %.4f, max |xi_hat| %.4f, min separation %.4f (%d statuses); "
+           "cf_sim: %.4f, %.4f, %.4f",
+           r.max_xi, r.max_xi_hat, r.min_separation, r.count, expected.max_xi,
+           expected.max_xi_hat, expected.min_separation);
+  EXPECT_GT(r.count, static_cast<int>(0.5 * end_time * scenario.controller.control_rate));
+  EXPECT_LE(r.max_xi_hat, design.xi_max);
+  if (expect_inside) {
+    EXPECT_LE(r.max_xi, design.xi_max);
+    EXPECT_GT(r.min_separation, design.perimeter);
+  } else {
+    EXPECT_GT(r.max_xi, design.xi_max);
+  }
+  EXPECT_NEAR(r.max_xi, expected.max_xi, tolerance);
+  EXPECT_NEAR(r.min_separation, expected.min_separation, tolerance);
+}
+
+}  // namespace
+}  // namespace projection_collision_avoidance
+
+int main(int argc, char** argv) {
+  ::testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_paper_run_ros");
+  return RUN_ALL_TESTS();
+}
