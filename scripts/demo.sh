@@ -11,8 +11,10 @@ out=${OUT_DIR:-$root/out}
 
 "$root/scripts/setup.sh"
 "$root/scripts/build.sh"
+set +u  # the workspace's setup scripts read unset variables
 # shellcheck disable=SC1091
 source "$root/build/devel/setup.bash"
+set -u
 cf_sim=$root/build/devel/lib/projection_collision_avoidance/cf_sim
 mkdir -p "$out"
 

@@ -6,8 +6,10 @@ set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 at=${1:-21.5}
 "$root/scripts/build.sh" >/dev/null
+set +u  # the workspace's setup scripts read unset variables
 # shellcheck disable=SC1091
 source "$root/build/devel/setup.bash"
+set -u
 export LIBGL_ALWAYS_SOFTWARE=1 DISPLAY=:97
 work=$(mktemp -d)
 Xvfb "$DISPLAY" -screen 0 1280x720x24 >"$work/xvfb.log" 2>&1 &

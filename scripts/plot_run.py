@@ -3,7 +3,7 @@
 
 Usage::
 
-    plot_run.py RUN.csv [RUN2.csv ...] -o OUT.png [--title T ...]
+    plot_run.py RUN.csv|RUN.bag [RUN2 ...] -o OUT.png [--title T ...] [--xlim T0 T1]
 
 Each run becomes one column of stacked subplots sharing the time axis:
 
@@ -19,9 +19,11 @@ Several runs are drawn side by side, with a common y range per row when the
 runs have the same layout, so e.g. Run 1 and Run 2 compare at a glance.
 
 The input is the CSV of ``cf_sim --csv`` / ``reference_sim.py --csv``
-(README.md, section 'Scenario files'). Loading is done by load_run(), which dispatches on
-the file name to a loader returning a dict of column name -> numpy array; a
-loader for other recordings (e.g. a rosbag) only has to return the same dict.
+(README.md, section 'Scenario files') or a rosbag recorded by the demo
+(``roslaunch projection_collision_avoidance demo.launch record:=true``; see load_bag()).
+Loading is done by load_run(), which dispatches on the file name to a loader
+returning a dict of column name -> numpy array, the same columns for every loader,
+so a bag and a CSV of the same run plot alike.
 """
 
 from __future__ import annotations
@@ -65,9 +67,218 @@ def load_csv(path):
     return {name: data[:, i] for i, name in enumerate(header)}
 
 
+# --------------------------------------------------------------------------
+# rosbag recordings (roslaunch projection_collision_avoidance demo.launch record:=true)
+# --------------------------------------------------------------------------
+
+# Topics of the demo's recording, by role. A role whose topic is not in the bag
+# is looked up by message type when exactly one topic has that type.
+BAG_TOPICS = {
+    "status": ("/follower/status", "projection_collision_avoidance/FollowerStatus"),
+    "leader_odom": ("/leader/odom", None),
+    "follower_odom": ("/follower/odom", None),
+    "broadcast": ("/leader/broadcast", "projection_collision_avoidance/LeaderBroadcast"),
+    "leader_command": ("/leader/command", None),
+}
+
+
+def _stamp(msg, record_time):
+    """A message's header stamp in s; its record time when the stamp is unset."""
+    stamp = msg.header.stamp
+    if stamp.secs == 0 and stamp.nsecs == 0:
+        return record_time.to_sec()
+    return stamp.to_sec()
+
+
+def _bag_topic_map(bag, path):
+    """{role: topic in this bag, or None}."""
+    info = bag.get_type_and_topic_info().topics
+    roles = {}
+    for role, (name, msg_type) in BAG_TOPICS.items():
+        topic = name if name in info else None
+        if topic is None and msg_type is not None:
+            same = [t for t, i in info.items() if i.msg_type == msg_type]
+            topic = same[0] if len(same) == 1 else None
+        roles[role] = topic
+    if roles["status"] is None:
+        raise ValueError(f"{path}: no {BAG_TOPICS['status'][0]} "
+                         f"({BAG_TOPICS['status'][1]}) messages")
+    return roles
+
+
+def _fixed_width(rows, width, what, path):
+    """rows (lists, possibly empty) as a (len, width) array; empty rows become zeros."""
+    out = np.zeros((len(rows), width))
+    for i, row in enumerate(rows):
+        if len(row) == width:
+            out[i] = row
+        elif len(row):
+            raise ValueError(f"{path}: {what} has {len(row)} entries, expected {width}")
+    return out
+
+
+def _hold(t_samples, values, t, width):
+    """Zero-order hold of values (one row per sample time) onto t; zeros before the first."""
+    out = np.zeros((t.size, width))
+    if not len(t_samples):
+        return out
+    order = np.argsort(t_samples, kind="stable")
+    ts, vs = np.asarray(t_samples)[order], np.asarray(values).reshape(-1, width)[order]
+    idx = np.searchsorted(ts, t, side="right") - 1
+    held = idx >= 0
+    out[held] = vs[idx[held]]
+    return out
+
+
+def _warn_gaps(path, topic, stamps, origin, how):
+    """Warn on stderr when a topic has a hole much longer than its usual interval.
+
+    rosbag record drops messages when it (or the machine) cannot keep up, e.g. at a high
+    real_time_factor; the columns taken from that topic are then filled in by `how`.
+    """
+    stamps = np.sort(np.asarray(stamps, dtype=float))
+    if stamps.size < 3:
+        return
+    gaps = np.diff(stamps)
+    limit = max(0.1, 20.0 * float(np.median(gaps)))
+    holes = np.flatnonzero(gaps > limit)
+    if holes.size:
+        worst = holes[np.argmax(gaps[holes])]
+        print(f"{PROG}: warning: {path}: {topic} has {holes.size} gap(s) longer than "
+              f"{limit:.3g} s, the longest {gaps[worst]:.3g} s from t = "
+              f"{stamps[worst] - origin:.3f} s (not published, or dropped by rosbag record); "
+              f"{how} across them", file=sys.stderr)
+
+
+def load_bag(path):
+    """Read a rosbag of the demo into the columns of the cf_sim CSV.
+
+    One row per /follower/status message (ordered by header stamp): t is the stamp, xi_*,
+    xi_hat_*, norms, bounds, f, projection_active, separation, perimeter and the commands
+    come from the status; leader/follower positions and velocities are /leader/odom and
+    /follower/odom linearly interpolated onto the status stamps; ud_* (leader disturbance)
+    and leader_u_* (leader input) are /leader/broadcast held from one broadcast to the next
+    (zeros before the first one, and ud_* zeros when the broadcast does not carry it);
+    leader_u_* falls back to /leader/command without broadcasts.
+
+    Messages are deserialised from the definitions stored in the bag, so the package's
+    generated Python messages need not be importable. Under simulated time (/clock in the
+    bag) t is the simulated time; otherwise t counts from the first odometry stamp (the
+    plant's tick 0), or the first status stamp without odometry.
+    """
+    try:
+        import rosbag  # Debian python3-rosbag; imported here so that CSVs need no ROS
+    except ImportError as exc:
+        raise ValueError(f"{path}: reading a bag needs the rosbag Python module "
+                         f"(python3-rosbag; run with /usr/bin/python3): {exc}") from None
+    try:
+        bag = rosbag.Bag(path)
+    except rosbag.ROSBagException as exc:
+        raise ValueError(f"{path}: not a readable bag ({exc})") from None
+    with bag:
+        roles = _bag_topic_map(bag, path)
+        sim_time = "/clock" in bag.get_type_and_topic_info().topics
+        by_topic = {}
+        for role, topic in roles.items():
+            if topic is not None:
+                by_topic.setdefault(topic, []).append(role)
+        data = {role: [] for role in roles}
+        for topic, msg, rec in bag.read_messages(topics=list(by_topic), raw=False):
+            for role in by_topic[topic]:
+                data[role].append((msg, rec))
+
+    status = sorted(data["status"], key=lambda mr: _stamp(*mr))
+    if not status:
+        raise ValueError(f"{path}: {roles['status']} has no messages")
+    msgs = [m for m, _ in status]
+    n = len(msgs[0].xi)
+    m = len(msgs[0].command)
+    if n == 0 or n % 2:
+        raise ValueError(f"{path}: status xi has {n} entries; expected 2 per axis "
+                         f"(double integrator)")
+    k = n // 2
+
+    def odometry(role):
+        samples = data[role]
+        if not samples:
+            raise ValueError(f"{path}: no {BAG_TOPICS[role][0]} messages")
+        samples = sorted(samples, key=lambda mr: _stamp(*mr))
+        ts = np.array([_stamp(mm, rr) for mm, rr in samples])
+        pos = np.array([[o.pose.pose.position.x, o.pose.pose.position.y,
+                         o.pose.pose.position.z][:k] for o, _ in samples])
+        vel = np.array([[o.twist.twist.linear.x, o.twist.twist.linear.y,
+                         o.twist.twist.linear.z][:k] for o, _ in samples])
+        return ts, pos, vel
+
+    leader_odom = odometry("leader_odom")
+    follower_odom = odometry("follower_odom")
+
+    t_abs = np.array([_stamp(mm, rr) for mm, rr in status])
+    if sim_time:
+        origin = 0.0
+    else:
+        origin = min(leader_odom[0][0], follower_odom[0][0])
+    t = t_abs - origin
+    _warn_gaps(path, roles["status"], t_abs, origin, "the plot draws straight lines")
+    for role, (ts, _, _) in (("leader_odom", leader_odom), ("follower_odom", follower_odom)):
+        _warn_gaps(path, roles[role], ts, origin, "positions and velocities are interpolated")
+
+    def status_array(field, width):
+        return _fixed_width([getattr(s, field) for s in msgs], width,
+                            f"{roles['status']} {field}", path)
+
+    cols = {"t": t}
+    xi = status_array("xi", n)
+    xi_hat = status_array("xi_hat", n)
+    for i in range(n):
+        cols[f"xi_{i}"] = xi[:, i]
+    for i in range(n):
+        cols[f"xi_hat_{i}"] = xi_hat[:, i]
+    for name, field in (("norm_xi", "xi_norm"), ("norm_xi_hat", "xi_hat_norm"),
+                        ("xi_max", "xi_max"), ("xi_soft", "xi_soft"), ("f", "constraint")):
+        cols[name] = np.array([getattr(s, field) for s in msgs], dtype=float)
+    cols["projection_active"] = np.array([1.0 if s.projection_active else 0.0 for s in msgs])
+
+    for who, (ts, pos, vel) in (("leader", leader_odom), ("follower", follower_odom)):
+        for i in range(k):
+            cols[f"{who}_p_{i}"] = np.interp(t_abs, ts, pos[:, i])
+    for who, (ts, pos, vel) in (("leader", leader_odom), ("follower", follower_odom)):
+        for i in range(k):
+            cols[f"{who}_v_{i}"] = np.interp(t_abs, ts, vel[:, i])
+
+    cols["separation"] = np.array([s.separation for s in msgs], dtype=float)
+    cols["perimeter"] = np.array([s.perimeter for s in msgs], dtype=float)
+    for prefix, field in (("u", "command"), ("u_baseline", "baseline_command"),
+                          ("u_tracker", "tracker_command")):
+        values = status_array(field, m)
+        for i in range(m):
+            cols[f"{prefix}_{i}"] = values[:, i]
+
+    broadcast = data["broadcast"]
+    if broadcast:
+        tb = [_stamp(mm, rr) for mm, rr in broadcast]
+        _warn_gaps(path, roles["broadcast"], tb, origin, "ud_* and leader_u_* are held")
+        leader_u = _hold(tb, _fixed_width([b.input for b, _ in broadcast], m,
+                                          f"{roles['broadcast']} input", path), t_abs, m)
+        ud = _hold(tb, _fixed_width([b.disturbance for b, _ in broadcast], n,
+                                    f"{roles['broadcast']} disturbance", path), t_abs, n)
+    else:
+        command = data["leader_command"]
+        tc = [_stamp(mm, rr) for mm, rr in command]
+        leader_u = _hold(tc, np.array([[c.accel.linear.x, c.accel.linear.y,
+                                        c.accel.linear.z][:m] for c, _ in command]),
+                         t_abs, m)
+        ud = np.zeros((t.size, n))
+    for i in range(m):
+        cols[f"leader_u_{i}"] = leader_u[:, i]
+    for i in range(n):
+        cols[f"ud_{i}"] = ud[:, i]
+    return cols
+
+
 # File-name suffix -> loader. Each loader returns {column: np.ndarray}
 # with the column names of README.md, section 'Scenario files'.
-LOADERS = {".csv": load_csv}
+LOADERS = {".csv": load_csv, ".bag": load_bag}
 
 REQUIRED = ("t", "xi_0", "xi_hat_0", "norm_xi", "norm_xi_hat", "xi_max", "xi_soft",
             "leader_p_0", "follower_p_0", "separation", "perimeter")
@@ -305,9 +516,9 @@ def plot_runs(runs, titles, out, dpi=110, column_width=7.0, xlim=None):
 def parse_args(argv):
     ap = argparse.ArgumentParser(
         prog="plot_run.py",
-        description="Plot leader-follower runs (CSV of cf_sim / reference_sim) like the "
-                    "paper's Figs. 4-7, one column per run.")
-    ap.add_argument("runs", nargs="+", metavar="RUN.csv", help="run recordings")
+        description="Plot leader-follower runs (CSV of cf_sim / reference_sim, or a rosbag "
+                    "of the demo) like the paper's Figs. 4-7, one column per run.")
+    ap.add_argument("runs", nargs="+", metavar="RUN.csv|RUN.bag", help="run recordings")
     ap.add_argument("-o", "--output", required=True, metavar="OUT.png", help="image to write")
     ap.add_argument("--title", action="append", default=[], metavar="T",
                     help="column title, once per run in order (default: file name)")

@@ -218,17 +218,25 @@ void FollowerNode::publishMarkers(const ros::Time& now, const Eigen::VectorXd& x
   const bool inside_perimeter = separation < design.perimeter;
   visualization_msgs::MarkerArray markers;
   // Safety perimeter alpha ||d|| around the follower: green, red once the leader is inside.
-  markers.markers.push_back(sphereMarker(frame, now, "perimeter", 0, Eigen::Vector3d::Zero(),
-                                         2.0 * design.perimeter, inside_perimeter ? 1.0F : 0.1F,
-                                         inside_perimeter ? 0.1F : 0.8F, 0.1F, 0.25F));
+  // A flat disc on the ground plane (a sphere in 3-D), so the markers above it stay visible.
+  visualization_msgs::Marker perimeter = sphereMarker(
+      frame, now, "perimeter", 0, Eigen::Vector3d::Zero(), 2.0 * design.perimeter,
+      inside_perimeter ? 1.0F : 0.1F, inside_perimeter ? 0.1F : 0.8F, 0.1F, 0.35F);
+  if (axes_ < 3) {
+    perimeter.type = visualization_msgs::Marker::CYLINDER;
+    perimeter.scale.z = 0.02;
+  }
+  markers.markers.push_back(perimeter);
   // The slot x_1 - d, relative to the follower: (p_1 - p_2) - d_p.
   const Eigen::VectorXd slot = relative_state_.head(axes_) - parameters_.separation.head(axes_);
-  markers.markers.push_back(
-      sphereMarker(frame, now, "slot", 0, toVector3(slot), 0.3, 0.6F, 0.6F, 0.6F, 0.8F));
+  visualization_msgs::Marker slot_marker =
+      sphereMarker(frame, now, "slot", 0, toVector3(slot), 0.3, 0.8F, 0.8F, 0.8F, 0.9F);
+  slot_marker.type = visualization_msgs::Marker::CUBE;
+  markers.markers.push_back(slot_marker);
   // The follower where the CF estimate puts it: p_2 + (xi - xi_hat)_p.
   const Eigen::VectorXd ghost = (xi - s.estimate).head(axes_);
   markers.markers.push_back(
-      sphereMarker(frame, now, "cf_estimate", 0, toVector3(ghost), 0.5, 1.0F, 0.55F, 0.0F, 0.35F));
+      sphereMarker(frame, now, "cf_estimate", 0, toVector3(ghost), 0.5, 1.0F, 0.55F, 0.0F, 0.45F));
   // ||xi|| against xi_max, as text above the follower.
   const float shade = xi.norm() > design.xi_max ? 0.2F : 1.0F;  // red outside the bound
   visualization_msgs::Marker text = sphereMarker(frame, now, "bound", 0,
