@@ -9,7 +9,7 @@ Reads the follower's status (/follower/status, projection_collision_avoidance/Fo
 the only topic of that type if the bag has no /follower/status) and prints one line in the
 format of cf_sim (README.md, 'The summary line')::
 
-    max_xi=... max_xi_hat=... xi_max=... min_separation=... time_outside=... wall_s=...
+    max_xi=... max_xi_hat=... xi_max=... min_separation=... time_outside=... recorded_s=...
 
   max_xi, max_xi_hat  largest xi_norm and xi_hat_norm over the status messages
   xi_max              the status's xi_max (the last one; a warning if it changed)
@@ -17,7 +17,7 @@ format of cf_sim (README.md, 'The summary line')::
   time_outside        total time of the status intervals [t_k, t_(k+1)) (header stamps) with
                       xi_norm > xi_max; the last message counts for the median interval, as
                       cf_sim counts whole control periods
-  wall_s              the time span over which the status messages were recorded (bag record
+  recorded_s          the time span over which the status messages were recorded (bag record
                       times, last - first). rosbag record stamps with ros::Time::now(), so under
                       simulated time (use_sim_time, the demo's default) this is simulated time,
                       not the wall-clock time of the run.
@@ -104,7 +104,7 @@ def summarize(path):
         "xi_max": rows[-1][3],
         "min_separation": min(r[4] for r in rows),
         "time_outside": sum(d for r, d in zip(rows, intervals) if r[1] > r[3]),
-        "wall_s": max(records) - min(records),
+        "recorded_s": max(records) - min(records),
     }
 
 
@@ -116,7 +116,7 @@ def main(argv=None):
     ap = argparse.ArgumentParser(
         prog="bag_summary.py",
         description="Print cf_sim's summary line (max_xi, max_xi_hat, xi_max, min_separation, "
-                    "time_outside, wall_s) for a rosbag of the demo, from /follower/status.")
+                    "time_outside, recorded_s) for a rosbag of the demo, from /follower/status.")
     ap.add_argument("bag", metavar="RUN.bag", help="bag recorded by demo.launch record:=true")
     args = ap.parse_args(argv)
     try:
