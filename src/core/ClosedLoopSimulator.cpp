@@ -73,7 +73,12 @@ SimulationSummary runClosedLoop(const Scenario& scenario, const ControllerDesign
     const auto& status = share_leader_input ? controller.step(y, leader_input) : controller.step(y);
 
     const double xi_norm = xi.norm();
-    const double separation_distance = (plant.leader() - plant.follower()).head(k).norm();
+    const StateVector offset = plant.leader() - plant.follower();
+    double separation_squared = 0.0;  // ||p_1 - p_2||^2 over the k position entries
+    for (int i = 0; i < k; ++i) {
+      separation_squared += offset(i) * offset(i);
+    }
+    const double separation_distance = std::sqrt(separation_squared);
     summary.max_xi = std::max(summary.max_xi, xi_norm);
     summary.max_xi_hat = std::max(summary.max_xi_hat, status.estimate_norm);
     summary.min_separation = std::min(summary.min_separation, separation_distance);
