@@ -56,6 +56,7 @@ visualization_msgs::Marker sphereMarker(const std::string& frame, const ros::Tim
   marker.pose.position.y = position.y();
   marker.pose.position.z = position.z();
   marker.pose.orientation.w = 1.0;
+  marker.frame_locked = true;  // follows the follower's tf frame between marker updates
   marker.scale.x = marker.scale.y = marker.scale.z = diameter;
   marker.color.r = r;
   marker.color.g = g;
