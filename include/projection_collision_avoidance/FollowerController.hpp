@@ -60,7 +60,8 @@ class FollowerController {
 
   /// One control period with the leader's current input u_1 (used as configured by
   /// leader_input_in_command / leader_input_in_estimator).
-  const FollowerControllerStatus<Dims>& step(const OutputVector& y, const InputVector& leader_input) {
+  const FollowerControllerStatus<Dims>& step(const OutputVector& y,
+                                             const InputVector& leader_input) {
     return advance(y, leader_input, true);
   }
 
@@ -83,8 +84,9 @@ class FollowerController {
   const CollisionFreeEstimator<Dims>& estimator() const { return estimator_; }
 
  private:
-  const FollowerControllerStatus<Dims>& advance(const OutputVector& y, const InputVector& leader_input,
-                                      bool leader_input_known) {
+  const FollowerControllerStatus<Dims>& advance(const OutputVector& y,
+                                                const InputVector& leader_input,
+                                                bool leader_input_known) {
     const ControllerParameters& p = design_.parameters;
     if (!initialized_) {
       if (p.initial_estimate == InitialEstimate::kMeasurement) {

@@ -1,7 +1,8 @@
 #pragma once
 
-#include <Eigen/Core>
 #include <variant>
+
+#include <Eigen/Core>
 
 #include "projection_collision_avoidance/ControllerDesign.hpp"
 #include "projection_collision_avoidance/FollowerController.hpp"
@@ -9,8 +10,8 @@
 
 namespace projection_collision_avoidance {
 
-/// FollowerControllerStatus with run-time sized vectors, for callers that learn the model's sizes from
-/// configuration (the ROS nodes). The vectors are sized once; a step only overwrites them.
+/// FollowerControllerStatus with run-time sized vectors, for callers that learn the model's sizes
+/// from configuration (the ROS nodes). The vectors are sized once; a step only overwrites them.
 struct RuntimeFollowerStatus {
   Eigen::VectorXd command;              ///< u_2
   Eigen::VectorXd baseline_command;     ///< G y (2)
@@ -20,7 +21,7 @@ struct RuntimeFollowerStatus {
   double estimate_norm = 0.0;           ///< ||xi_hat|| (m)
   double constraint_value = 0.0;        ///< f(xi_hat) (13)
   bool projection_active = false;
-  double boundary_correction = 0.0;     ///< (m)
+  double boundary_correction = 0.0;  ///< (m)
 };
 
 /// A FollowerController whose compile-time dimensions are chosen at run time from the model

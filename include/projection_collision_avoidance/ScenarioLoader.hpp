@@ -4,10 +4,10 @@
 /// Reads the YAML scenario format of README.md, "Scenario files" (yaml-cpp). Every error is a
 /// ParameterError whose key is the dotted path of the offending entry.
 
-#include <yaml-cpp/yaml.h>
-
 #include <string>
 #include <vector>
+
+#include <yaml-cpp/yaml.h>
 
 #include "projection_collision_avoidance/Scenario.hpp"
 

@@ -1,11 +1,11 @@
 #include "projection_collision_avoidance/ros/FollowerNode.hpp"
 
-#include <geometry_msgs/AccelStamped.h>
-#include <visualization_msgs/MarkerArray.h>
-
 #include <cmath>
 #include <iomanip>
 #include <sstream>
+
+#include <geometry_msgs/AccelStamped.h>
+#include <visualization_msgs/MarkerArray.h>
 
 #include "projection_collision_avoidance/ControllerDesign.hpp"
 #include "projection_collision_avoidance/FollowerStatus.h"
@@ -15,18 +15,6 @@
 
 namespace projection_collision_avoidance {
 namespace {
-
-/// The controller part of the scenario in ~scenario; the ROS nodes need double integrators,
-/// whose relative state is a position and a velocity.
-ControllerParameters loadControllerParameters(const ros::NodeHandle& private_nh) {
-  const Scenario scenario = loadScenarioParameter(private_nh);
-  if (!scenario.controller.model.isDoubleIntegrator()) {
-    throw ParameterError("~scenario/model/type",
-                         "the ROS nodes run double_integrator models (relative position and "
-                         "velocity); use cf_sim for a linear model");
-  }
-  return scenario.controller;
-}
 
 FollowerNodeOptions readOptions(NodeOptionReader& reader, const ControllerParameters& p) {
   FollowerNodeOptions options;
@@ -43,8 +31,8 @@ FollowerNodeOptions readOptions(NodeOptionReader& reader, const ControllerParame
 
 visualization_msgs::Marker sphereMarker(const std::string& frame, const ros::Time& stamp,
                                         const std::string& ns, int id,
-                                        const Eigen::Vector3d& position, double diameter,
-                                        float r, float g, float b, float a) {
+                                        const Eigen::Vector3d& position, double diameter, float r,
+                                        float g, float b, float a) {
   visualization_msgs::Marker marker;
   marker.header.frame_id = frame;
   marker.header.stamp = stamp;
@@ -70,7 +58,7 @@ visualization_msgs::Marker sphereMarker(const std::string& frame, const ros::Tim
 FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
     : nh_(nh),
       private_nh_(private_nh),
-      parameters_(loadControllerParameters(private_nh)),
+      parameters_(loadDoubleIntegratorScenario(private_nh).controller),
       controller_(ControllerDesign::create(parameters_)),
       axes_(parameters_.model.double_integrator_axes),
       diagnostics_(nh, private_nh),
@@ -220,9 +208,9 @@ void FollowerNode::publishMarkers(const ros::Time& now, const Eigen::VectorXd& x
   visualization_msgs::MarkerArray markers;
   // Safety perimeter alpha ||d|| around the follower: green, red once the leader is inside.
   // A flat disc on the ground plane (a sphere in 3-D), so the markers above it stay visible.
-  visualization_msgs::Marker perimeter = sphereMarker(
-      frame, now, "perimeter", 0, Eigen::Vector3d::Zero(), 2.0 * design.perimeter,
-      inside_perimeter ? 1.0F : 0.1F, inside_perimeter ? 0.1F : 0.8F, 0.1F, 0.35F);
+  visualization_msgs::Marker perimeter =
+      sphereMarker(frame, now, "perimeter", 0, Eigen::Vector3d::Zero(), 2.0 * design.perimeter,
+                   inside_perimeter ? 1.0F : 0.1F, inside_perimeter ? 0.1F : 0.8F, 0.1F, 0.35F);
   if (axes_ < 3) {
     perimeter.type = visualization_msgs::Marker::CYLINDER;
     perimeter.scale.z = 0.02;
@@ -240,9 +228,8 @@ void FollowerNode::publishMarkers(const ros::Time& now, const Eigen::VectorXd& x
       sphereMarker(frame, now, "cf_estimate", 0, toVector3(ghost), 0.5, 1.0F, 0.55F, 0.0F, 0.45F));
   // ||xi|| against xi_max, as text above the follower.
   const float shade = xi.norm() > design.xi_max ? 0.2F : 1.0F;  // red outside the bound
-  visualization_msgs::Marker text = sphereMarker(frame, now, "bound", 0,
-                                                 Eigen::Vector3d(0.0, 0.0, 1.2), 0.35, 1.0F,
-                                                 shade, shade, 1.0F);
+  visualization_msgs::Marker text = sphereMarker(
+      frame, now, "bound", 0, Eigen::Vector3d(0.0, 0.0, 1.2), 0.35, 1.0F, shade, shade, 1.0F);
   text.type = visualization_msgs::Marker::TEXT_VIEW_FACING;
   std::ostringstream label;
   label << std::fixed << std::setprecision(2) << "|xi| " << xi.norm() << " / xi_max "

@@ -10,17 +10,6 @@
 namespace projection_collision_avoidance {
 namespace {
 
-/// The scenario in ~scenario; the ROS nodes run double integrators only.
-Scenario loadLeaderScenario(const ros::NodeHandle& private_nh) {
-  Scenario scenario = loadScenarioParameter(private_nh);
-  if (!scenario.controller.model.isDoubleIntegrator()) {
-    throw ParameterError("~scenario/model/type",
-                         "the ROS nodes run double_integrator models only; use cf_sim for a "
-                         "linear model");
-  }
-  return scenario;
-}
-
 LeaderNodeOptions readOptions(NodeOptionReader& reader, const Scenario& scenario) {
   LeaderNodeOptions o;
   o.rate = reader.number("rate", scenario.controller.control_rate, 1.0, 10000.0);
@@ -37,7 +26,7 @@ LeaderNodeOptions readOptions(NodeOptionReader& reader, const Scenario& scenario
 LeaderNode::LeaderNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
     : nh_(nh),
       name_(ros::this_node::getName()),
-      scenario_(loadLeaderScenario(private_nh)),
+      scenario_(loadDoubleIntegratorScenario(private_nh)),
       axes_(scenario_.controller.model.double_integrator_axes) {
   NodeOptionReader reader(private_nh);
   options_ = readOptions(reader, scenario_);

@@ -1,9 +1,9 @@
 #include "projection_collision_avoidance/ros/MessageConversions.hpp"
 
-#include <tf2_eigen/tf2_eigen.h>
+#include <algorithm>
 
 #include <Eigen/Geometry>
-#include <algorithm>
+#include <tf2_eigen/tf2_eigen.h>
 
 namespace projection_collision_avoidance {
 
@@ -60,8 +60,8 @@ geometry_msgs::AccelStamped toAccelMsg(const Eigen::Ref<const Eigen::VectorXd>& 
   return msg;
 }
 
-bool commandFromAccelMsg(const geometry_msgs::AccelStamped& msg, int axes,
-                         Eigen::VectorXd* command, std::string* why) {
+bool commandFromAccelMsg(const geometry_msgs::AccelStamped& msg, int axes, Eigen::VectorXd* command,
+                         std::string* why) {
   Eigen::Vector3d linear;
   tf2::fromMsg(msg.accel.linear, linear);
   if (!linear.allFinite()) {

@@ -1,9 +1,9 @@
 /// The three nodes as nodelets: each owns the same class the stand-alone node runs.
 
+#include <memory>
+
 #include <nodelet/nodelet.h>
 #include <pluginlib/class_list_macros.hpp>
-
-#include <memory>
 
 #include "projection_collision_avoidance/ParameterError.hpp"
 #include "projection_collision_avoidance/ros/FollowerNode.hpp"

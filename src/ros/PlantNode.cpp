@@ -26,17 +26,6 @@ constexpr double kMaxCatchUp = 0.05;
 /// Wall seconds between the last tick's messages and the shutdown, to let them out.
 constexpr double kShutdownDelay = 0.25;
 
-/// The scenario in ~scenario; the plant simulates double integrators only.
-Scenario loadPlantScenario(const ros::NodeHandle& private_nh) {
-  Scenario scenario = loadScenarioParameter(private_nh);
-  if (!scenario.controller.model.isDoubleIntegrator()) {
-    throw ParameterError("~scenario/model/type",
-                         "the plant simulates double_integrator models only; use cf_sim for a "
-                         "linear model");
-  }
-  return scenario;
-}
-
 std::string frameParameter(NodeOptionReader& reader, const std::string& key,
                            const std::string& fallback) {
   const std::string frame = reader.text(key, fallback);
@@ -124,7 +113,7 @@ PlantNode::Agent::Agent(const std::string& agent_name, const std::string& tf_fra
 PlantNode::PlantNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
     : nh_(nh),
       name_(ros::this_node::getName()),
-      scenario_(loadPlantScenario(private_nh)),
+      scenario_(loadDoubleIntegratorScenario(private_nh)),
       reader_(private_nh),
       options_(readOptions(reader_, scenario_)),
       axes_(scenario_.controller.model.double_integrator_axes),

@@ -1,9 +1,9 @@
 #include "projection_collision_avoidance/ros/RosParameters.hpp"
 
-#include <ros/console.h>
-
 #include <algorithm>
 #include <sstream>
+
+#include <ros/console.h>
 
 #include "projection_collision_avoidance/ParameterError.hpp"
 #include "projection_collision_avoidance/ScenarioLoader.hpp"
@@ -74,7 +74,8 @@ Scenario loadScenarioParameter(const ros::NodeHandle& private_nh, const std::str
   if (!private_nh.getParam(name, value)) {
     throw ParameterError("~" + name,
                          "missing: load a scenario file into it (<rosparam command=\"load\" "
-                         "file=\"...\" ns=\"" + name + "\"/>) or give its path");
+                         "file=\"...\" ns=\"" +
+                             name + "\"/>) or give its path");
   }
   try {
     if (value.getType() == XmlRpc::XmlRpcValue::TypeString) {
@@ -87,6 +88,16 @@ Scenario loadScenarioParameter(const ros::NodeHandle& private_nh, const std::str
   } catch (const ParameterError& error) {
     throw ParameterError(parameterName(name, error.key()), error.reason());
   }
+}
+
+Scenario loadDoubleIntegratorScenario(const ros::NodeHandle& private_nh, const std::string& name) {
+  Scenario scenario = loadScenarioParameter(private_nh, name);
+  if (!scenario.controller.model.isDoubleIntegrator()) {
+    throw ParameterError("~" + name + "/model/type",
+                         "the ROS nodes run double_integrator models (relative position and "
+                         "velocity); use cf_sim for a linear model");
+  }
+  return scenario;
 }
 
 bool NodeOptionReader::lookup(const std::string& key, XmlRpc::XmlRpcValue* value) const {

@@ -1,5 +1,5 @@
-#include "projection_collision_avoidance/ros/PlantNode.hpp"
 #include "projection_collision_avoidance/ros/NodeMain.hpp"
+#include "projection_collision_avoidance/ros/PlantNode.hpp"
 
 int main(int argc, char** argv) {
   return projection_collision_avoidance::runNode<projection_collision_avoidance::PlantNode>(

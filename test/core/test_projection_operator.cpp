@@ -12,6 +12,7 @@
 #include "projection_collision_avoidance/ProjectionOperator.hpp"
 
 #include "EigenTestHelpers.hpp"
+#include "TestScenarios.hpp"
 
 namespace projection_collision_avoidance {
 namespace {
@@ -177,19 +178,10 @@ TEST(BallConstraint, LevelSetsAreTheSoftAndHardBalls) {
 
 /// A design with a strongly non-normal A_c + L C (so Gamma is far from c I).
 ControllerDesign skewedDesign(int substeps) {
-  ControllerParameters p;
-  p.model = makeDoubleIntegrator(1);
-  p.control_rate = 100.0;
-  p.separation = Eigen::Vector2d(5.0, 0.0);
-  p.alpha = 0.2;
-  p.epsilon = 0.2;
-  p.baseline_gain = Eigen::RowVector2d(1.0, 1.4);
+  ControllerParameters p = testing::paperParameters();
   p.estimator_gain = (Eigen::Matrix2d() << -5.0, 3.0, -8.0, -2.0).finished();
   p.lyapunov_weight = (Eigen::Matrix2d() << 1.0, 0.3, 0.3, 4.0).finished();
   p.estimator_substeps = substeps;
-  p.tracker_enabled = true;
-  p.tracker_gain = Eigen::RowVector2d(10.0, 5.0);
-  p.reference_gain = Eigen::RowVector2d::Zero();
   return ControllerDesign::create(p);
 }
 

@@ -4,10 +4,11 @@
 
 #include <gtest/gtest.h>
 
-#include "EigenTestHelpers.hpp"
-#include "TestScenarios.hpp"
 #include "projection_collision_avoidance/RuntimeFollowerController.hpp"
 #include "projection_collision_avoidance/ScenarioEmbedding.hpp"
+
+#include "EigenTestHelpers.hpp"
+#include "TestScenarios.hpp"
 
 namespace projection_collision_avoidance {
 namespace {

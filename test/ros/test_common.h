@@ -4,16 +4,16 @@
 /// Fixture of the rostests: subscribes to what the follower publishes, and waits on conditions
 /// with wall-clock deadlines (never fixed sleeps).
 
-#include <diagnostic_msgs/DiagnosticArray.h>
-#include <gtest/gtest.h>
-#include <ros/ros.h>
-#include <visualization_msgs/MarkerArray.h>
-
 #include <functional>
 #include <limits>
 #include <mutex>
 #include <string>
 #include <vector>
+
+#include <diagnostic_msgs/DiagnosticArray.h>
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+#include <visualization_msgs/MarkerArray.h>
 
 #include "projection_collision_avoidance/FollowerStatus.h"
 

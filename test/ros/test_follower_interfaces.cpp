@@ -2,13 +2,13 @@
 /// and its dynamic_reconfigure interface, on the paper's Run 2. Parameters of the test node:
 ///   ~wall_deadline  wall seconds to wait for each condition
 
+#include <set>
+
 #include <dynamic_reconfigure/Reconfigure.h>
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
-
-#include <set>
 
 #include "test_common.h"
 
@@ -60,8 +60,8 @@ TEST_F(FollowerTest, PublishesStatusWithTheScenariosBounds) {
   EXPECT_NEAR(s.xi_soft, 4.0 / std::sqrt(1.2), 1e-12);
   EXPECT_DOUBLE_EQ(s.perimeter, 1.0);
   EXPECT_NEAR(s.margin, s.xi_max - s.xi_norm, 1e-12);
-  EXPECT_NEAR(s.command[0], s.baseline_command[0] + s.tracker_command[0] +
-                                s.feedforward_command[0], 1e-12);
+  EXPECT_NEAR(s.command[0], s.baseline_command[0] + s.tracker_command[0] + s.feedforward_command[0],
+              1e-12);
   EXPECT_TRUE(s.tracker_enabled);
   EXPECT_NEAR(s.separation, 5.0, 0.05);  // before the disturbance the follower holds its slot
 }
@@ -74,7 +74,7 @@ TEST_F(FollowerTest, PublishesMarkersInTheFollowerFrame) {
     namespaces.insert(marker.ns);
     EXPECT_EQ(marker.header.frame_id, "follower");
     if (marker.ns == "perimeter") {
-      EXPECT_DOUBLE_EQ(marker.scale.x, 2.0);  // diameter 2 alpha ||d||
+      EXPECT_DOUBLE_EQ(marker.scale.x, 2.0);      // diameter 2 alpha ||d||
       EXPECT_GT(marker.color.g, marker.color.r);  // green: the leader is outside the perimeter
     }
     if (marker.ns == "slot") {

@@ -13,6 +13,7 @@
 #include "projection_collision_avoidance/ClosedLoopSimulator.hpp"
 #include "projection_collision_avoidance/ControllerDesign.hpp"
 #include "projection_collision_avoidance/ros/RosParameters.hpp"
+
 #include "test_common.h"
 
 namespace projection_collision_avoidance {
@@ -33,10 +34,11 @@ TEST_F(FollowerTest, PaperRunThroughTheRosGraph) {
   ASSERT_TRUE(waitForStatusTime(end_time, param("wall_deadline")))
       << "no status at t >= " << end_time << " s; last " << record().last_time << " s";
   const testing::StatusRecord r = record();
-  ROS_INFO("ROS run: max |xi| %.4f, max |xi_hat| %.4f, min separation %.4f (%d statuses); "
-           "cf_sim: %.4f, %.4f, %.4f",
-           r.max_xi, r.max_xi_hat, r.min_separation, r.count, expected.max_xi,
-           expected.max_xi_hat, expected.min_separation);
+  ROS_INFO(
+      "ROS run: max |xi| %.4f, max |xi_hat| %.4f, min separation %.4f (%d statuses); "
+      "cf_sim: %.4f, %.4f, %.4f",
+      r.max_xi, r.max_xi_hat, r.min_separation, r.count, expected.max_xi, expected.max_xi_hat,
+      expected.min_separation);
   EXPECT_GT(r.count, static_cast<int>(0.5 * end_time * scenario.controller.control_rate));
   EXPECT_LE(r.max_xi_hat, design.xi_max);
   if (expect_inside) {

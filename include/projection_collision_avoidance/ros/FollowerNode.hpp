@@ -1,13 +1,13 @@
 #pragma once
 
-#include <diagnostic_updater/diagnostic_updater.h>
-#include <dynamic_reconfigure/server.h>
-#include <ros/ros.h>
+#include <mutex>
+#include <string>
 
 #include <Eigen/Core>
 #include <boost/thread/recursive_mutex.hpp>
-#include <mutex>
-#include <string>
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <dynamic_reconfigure/server.h>
+#include <ros/ros.h>
 
 #include "projection_collision_avoidance/FollowerConfig.h"
 #include "projection_collision_avoidance/LeaderBroadcast.h"
@@ -19,12 +19,12 @@ namespace projection_collision_avoidance {
 
 /// The follower node's own options (besides the scenario), read once from its private namespace.
 struct FollowerNodeOptions {
-  double measurement_timeout = 0.5;   ///< s; older measurements are reported stale
-  double leader_timeout = 0.5;        ///< s; older leader broadcasts are not used
-  bool use_leader_broadcast = false;  ///< subscribe to leader_broadcast for u_1
-  std::string measurement_frame;      ///< required frame_id of measurements ("" = any)
+  double measurement_timeout = 0.5;         ///< s; older measurements are reported stale
+  double leader_timeout = 0.5;              ///< s; older leader broadcasts are not used
+  bool use_leader_broadcast = false;        ///< subscribe to leader_broadcast for u_1
+  std::string measurement_frame;            ///< required frame_id of measurements ("" = any)
   std::string follower_frame = "follower";  ///< frame of the command, status and markers
-  double marker_rate = 10.0;          ///< Hz
+  double marker_rate = 10.0;                ///< Hz
 };
 
 /// ROS wrapper of RuntimeFollowerController: translates messages and time, nothing else.

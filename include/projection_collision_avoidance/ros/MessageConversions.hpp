@@ -4,14 +4,14 @@
 /// Conversions between the core's Eigen vectors and ROS messages, as free functions. Agents are
 /// double integrators in k = 1..3 axes: state [p; v], positions along x, y, z in that order.
 
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
 #include <geometry_msgs/AccelStamped.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <nav_msgs/Odometry.h>
 #include <ros/time.h>
-
-#include <Eigen/Core>
-#include <string>
-#include <vector>
 
 #include "projection_collision_avoidance/LeaderBroadcast.h"
 #include "projection_collision_avoidance/RelativeMeasurement.h"
@@ -43,8 +43,8 @@ geometry_msgs::AccelStamped toAccelMsg(const Eigen::Ref<const Eigen::VectorXd>& 
 /// The first @p axes linear entries of an AccelStamped.
 /// @return false, with the reason in @p why, for a non-finite entry or a non-zero entry beyond
 ///         the model's axes
-bool commandFromAccelMsg(const geometry_msgs::AccelStamped& msg, int axes,
-                         Eigen::VectorXd* command, std::string* why);
+bool commandFromAccelMsg(const geometry_msgs::AccelStamped& msg, int axes, Eigen::VectorXd* command,
+                         std::string* why);
 
 /// Odometry of an agent's state [p; v] (2 axes entries): pose position and twist linear, identity
 /// orientation, in @p frame with child @p child_frame.

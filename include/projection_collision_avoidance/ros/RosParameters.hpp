@@ -5,12 +5,12 @@
 /// own options. Every failure is a ParameterError whose key is the parameter's name
 /// ("~scenario/controller/alpha", "~measurement_timeout").
 
+#include <string>
+#include <vector>
+
 #include <ros/node_handle.h>
 #include <xmlrpcpp/XmlRpcValue.h>
 #include <yaml-cpp/yaml.h>
-
-#include <string>
-#include <vector>
 
 #include "projection_collision_avoidance/Scenario.hpp"
 
@@ -24,6 +24,11 @@ YAML::Node toYaml(const XmlRpc::XmlRpcValue& value);
 /// path of a scenario file. Errors name "~<name>/<dotted/path>".
 Scenario loadScenarioParameter(const ros::NodeHandle& private_nh,
                                const std::string& name = "scenario");
+
+/// As loadScenarioParameter(), refusing a model other than a double integrator (the ROS nodes
+/// exchange relative positions and velocities) with ParameterError("~<name>/model/type").
+Scenario loadDoubleIntegratorScenario(const ros::NodeHandle& private_nh,
+                                      const std::string& name = "scenario");
 
 /// Reads a node's own private options, checks each once, and remembers them for echo().
 class NodeOptionReader {
