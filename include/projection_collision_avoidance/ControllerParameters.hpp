@@ -1,5 +1,6 @@
 #pragma once
 
+#include <limits>
 #include <string>
 
 #include <Eigen/Core>
@@ -32,6 +33,9 @@ struct ControllerParameters {
   Eigen::MatrixXd reference_gain;          ///< S_21, m x p (19)
   bool leader_input_in_command = false;    ///< add the leader's input u_1 to the command
   bool leader_input_in_estimator = false;  ///< model B (u_1 - u_ff) in the estimator drift
+  /// Bound on the command's norm ||u_2|| (m/s^2 for double integrators); a larger command is
+  /// scaled onto it. Infinity: no bound.
+  double acceleration_limit = std::numeric_limits<double>::infinity();
 };
 
 /// Gain matrix of a k-axis double integrator with C = I from per-axis natural frequency

@@ -10,13 +10,14 @@ namespace projection_collision_avoidance {
 /// Everything the follower computed at one control tick.
 template <typename Dims>
 struct FollowerControllerStatus {
-  typename Dims::InputVector command;              ///< u_2 = baseline + tracker + feed-forward
+  typename Dims::InputVector command;  ///< u_2 = baseline + tracker + feed-forward, saturated
   typename Dims::InputVector baseline_command;     ///< G y (2)
   typename Dims::InputVector tracker_command;      ///< u_a (19)
   typename Dims::InputVector feedforward_command;  ///< u_1 when shared into the command, else 0
   typename Dims::StateVector estimate;             ///< xi_hat used at this tick (m)
   double estimate_norm = 0.0;                      ///< ||xi_hat|| (m)
   double constraint_value = 0.0;                   ///< f(xi_hat) (13)
+  bool command_saturated = false;    ///< the sum exceeded acceleration_limit and was scaled
   bool projection_active = false;    ///< the projection acted during the period that follows
   double boundary_correction = 0.0;  ///< see EstimatorPeriodReport (m)
 };
@@ -25,9 +26,11 @@ struct FollowerControllerStatus {
 /// tracks the CF estimator (11)-(15). One step() per control period T.
 ///
 /// At a tick with measurement y = C xi the command is
-///   u_2 = G y + u_a + u_ff,   u_a = G_e (y - C xi_hat) + S_21 C xi_hat,
-/// computed from the current estimate; the estimate is then integrated over [t, t + T] with y
-/// and u_a held. A step allocates no memory.
+///   u_2 = sat(G y + u_a + u_ff),   u_a = G_e (y - C xi_hat) + S_21 C xi_hat,
+/// computed from the current estimate, where sat() scales a vector longer than
+/// acceleration_limit onto it. The estimate is then integrated over [t, t + T] with y held and
+/// the augmentation that actually acts, u_2 - G y - u_ff (u_a when not saturated), so that its
+/// model of xi' stays that of the plant. A step allocates no memory.
 template <typename Dims>
 class FollowerController {
  public:
@@ -110,12 +113,20 @@ class FollowerController {
     }
     status_.command =
         status_.baseline_command + status_.tracker_command + status_.feedforward_command;
+    const double norm = status_.command.norm();
+    status_.command_saturated = norm > p.acceleration_limit;
+    InputVector acting_augmentation = status_.tracker_command;
+    if (status_.command_saturated) {
+      status_.command *= p.acceleration_limit / norm;
+      acting_augmentation =
+          status_.command - status_.baseline_command - status_.feedforward_command;
+    }
 
     StateVector known_drift = StateVector::Zero(input_matrix_.rows());
     if (leader_input_known && p.leader_input_in_estimator) {
       known_drift = input_matrix_ * (leader_input - status_.feedforward_command);
     }
-    const EstimatorPeriodReport report = estimator_.advance(y, status_.tracker_command, known_drift,
+    const EstimatorPeriodReport report = estimator_.advance(y, acting_augmentation, known_drift,
                                                             design_.period, p.estimator_substeps);
     status_.projection_active = report.projection_active;
     status_.boundary_correction = report.boundary_correction;

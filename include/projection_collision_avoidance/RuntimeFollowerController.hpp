@@ -20,6 +20,7 @@ struct RuntimeFollowerStatus {
   Eigen::VectorXd estimate;             ///< xi_hat used at this tick (m)
   double estimate_norm = 0.0;           ///< ||xi_hat|| (m)
   double constraint_value = 0.0;        ///< f(xi_hat) (13)
+  bool command_saturated = false;       ///< the command was scaled onto acceleration_limit
   bool projection_active = false;
   double boundary_correction = 0.0;  ///< (m)
 };

@@ -38,6 +38,10 @@ void validateScalars(const ControllerParameters& p) {
     throw ParameterError("controller.epsilon",
                          "must be positive, got " + std::to_string(p.epsilon));
   }
+  if (!(p.acceleration_limit > 0.0)) {  // also refuses NaN; infinity means no bound
+    throw ParameterError("controller.acceleration_limit", "must be positive (m/s^2) or .inf, got " +
+                                                              std::to_string(p.acceleration_limit));
+  }
   if (p.estimator_substeps < 1 || p.estimator_substeps > kMaxEstimatorSubsteps) {
     throw ParameterError("controller.estimator.substeps",
                          "must be between 1 and " + std::to_string(kMaxEstimatorSubsteps) +

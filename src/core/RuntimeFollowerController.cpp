@@ -17,6 +17,7 @@ void copyStatus(const FollowerControllerStatus<Dims>& from, RuntimeFollowerStatu
   to->estimate = from.estimate;
   to->estimate_norm = from.estimate_norm;
   to->constraint_value = from.constraint_value;
+  to->command_saturated = from.command_saturated;
   to->projection_active = from.projection_active;
   to->boundary_correction = from.boundary_correction;
 }

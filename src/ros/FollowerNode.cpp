@@ -189,6 +189,7 @@ void FollowerNode::publishStatus(const ros::Time& now, const Eigen::VectorXd& xi
   msg.margin = design.xi_max - msg.xi_norm;
   msg.constraint = s.constraint_value;
   msg.projection_active = s.projection_active;
+  msg.command_saturated = s.command_saturated;
   msg.tracker_enabled = parameters_.tracker_enabled;
   msg.command = toStdVector(s.command);
   msg.baseline_command = toStdVector(s.baseline_command);
@@ -259,6 +260,7 @@ void FollowerNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
   status.add("margin (m)", design.xi_max - last_xi_norm_);
   status.add("estimate_norm (m)", controller_.status().estimate_norm);
   status.add("projection_active", controller_.status().projection_active);
+  status.add("command_saturated", controller_.status().command_saturated);
   status.add("tracker_enabled", parameters_.tracker_enabled);
   status.add("rejected_measurements", rejected_measurements_);
   status.add("measurement_age (s)",

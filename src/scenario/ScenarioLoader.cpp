@@ -170,6 +170,9 @@ ControllerParameters readController(detail::YamlReader& reader, const AgentModel
                                                         : Eigen::MatrixXd::Zero(m, p);
   tracker.finish();
 
+  if (controller.has("acceleration_limit")) {
+    result.acceleration_limit = controller.number("acceleration_limit");
+  }
   if (controller.has("leader_information")) {
     detail::YamlReader sharing = controller.map("leader_information");
     if (sharing.has("command")) {

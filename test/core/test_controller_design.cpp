@@ -180,6 +180,16 @@ TEST(ControllerDesign, RefusesABadLyapunovWeight) {
                 "controller.estimator.lyapunov_weight", "positive definite");
 }
 
+TEST(ControllerDesign, RefusesANonPositiveAccelerationLimit) {
+  expectRefused([](auto& p) { p.acceleration_limit = 0.0; }, "controller.acceleration_limit",
+                "positive");
+  expectRefused([](auto& p) { p.acceleration_limit = -1.0; }, "controller.acceleration_limit");
+  expectRefused([](auto& p) { p.acceleration_limit = kNaN; }, "controller.acceleration_limit");
+  ControllerParameters p = paperParameters();
+  p.acceleration_limit = kInf;  // no bound
+  EXPECT_NO_THROW(ControllerDesign::create(p));
+}
+
 TEST(ControllerDesign, RefusesBadRatesAndSubsteps) {
   expectRefused([](auto& p) { p.control_rate = 0.0; }, "controller.control_rate", "positive");
   expectRefused([](auto& p) { p.control_rate = -100.0; }, "controller.control_rate", "positive");

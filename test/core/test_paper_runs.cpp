@@ -106,6 +106,37 @@ TEST(PaperRuns, RotatedIntoTwoAndThreeDimensionsGivesTheSameNorms) {
   }
 }
 
+// With an acceleration limit the command never exceeds it, the status says when it acted, the
+// estimate still respects its bound, and Run 2 stays safe with a limit the unsaturated run
+// exceeds.
+TEST(PaperRuns, AccelerationLimitBoundsTheCommand) {
+  const Trace free_run = run(loadScenarioFile(scenarioPath("paper_run2.yaml")));
+  double largest = 0.0;
+  for (const SimulationSample& sample : free_run.samples) {
+    largest = std::max(largest, sample.command.norm());
+  }
+  const double limit = 0.8 * largest;
+  Scenario scenario = loadScenarioFile(scenarioPath("paper_run2.yaml"));
+  scenario.controller.acceleration_limit = limit;
+  const Trace limited = run(scenario);
+  int saturated = 0;
+  for (const SimulationSample& sample : limited.samples) {
+    ASSERT_LE(sample.command.norm(), limit * (1.0 + 1e-12)) << "t=" << sample.time;
+    ASSERT_LE(sample.estimate.norm(), limited.summary.xi_max);
+    const Eigen::VectorXd sum = sample.baseline_command + sample.tracker_command;
+    if (sum.norm() > limit) {
+      ++saturated;
+      EXPECT_NEAR(sample.command.norm(), limit, 1e-9);
+      EXPECT_NEAR(sample.command.normalized().dot(sum.normalized()), 1.0, 1e-12);  // direction
+    } else {
+      ASSERT_NEAR((sample.command - sum).norm(), 0.0, 1e-12);
+    }
+  }
+  EXPECT_GT(saturated, 0);
+  EXPECT_LT(limited.summary.max_xi, limited.summary.xi_max);
+  EXPECT_GT(limited.summary.min_separation, limited.summary.perimeter);
+}
+
 // A 2-D run through the generic (run-time sized) controller matches the fixed-size one.
 TEST(PaperRuns, GenericDimensionsMatchFixedDimensions) {
   const Scenario one_axis = loadScenarioFile(scenarioPath("paper_run2.yaml"));

@@ -81,6 +81,10 @@ TEST(ScenarioLoader, AppliesOverridesByDottedPath) {
   EXPECT_DOUBLE_EQ(s.leader_input.sinusoids[0].frequency, 0.5);
   EXPECT_DOUBLE_EQ(s.leader_input.sinusoids[0].phase, 0.0);
   EXPECT_TRUE(s.controller.leader_input_in_command);
+  EXPECT_TRUE(std::isinf(s.controller.acceleration_limit));  // absent: no bound
+  EXPECT_DOUBLE_EQ(parseScenario(paperText(), {"controller.acceleration_limit=9.81"})
+                       .controller.acceleration_limit,
+                   9.81);
   EXPECT_FALSE(s.controller.leader_input_in_estimator);
   EXPECT_NEAR(s.leader_input.value(1.5, 1)(0), 0.5 + 0.2 * std::sin(2.0 * M_PI * 0.75), 1e-12);
 }

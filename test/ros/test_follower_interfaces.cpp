@@ -63,6 +63,7 @@ TEST_F(FollowerTest, PublishesStatusWithTheScenariosBounds) {
   EXPECT_NEAR(s.command[0], s.baseline_command[0] + s.tracker_command[0] + s.feedforward_command[0],
               1e-12);
   EXPECT_TRUE(s.tracker_enabled);
+  EXPECT_FALSE(s.command_saturated);
   EXPECT_NEAR(s.separation, 5.0, 0.05);  // before the disturbance the follower holds its slot
 }
 
