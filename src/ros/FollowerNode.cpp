@@ -22,6 +22,8 @@ FollowerNodeOptions readOptions(NodeOptionReader& reader, const ControllerParame
   options.measurement_timeout =
       reader.number("measurement_timeout", options.measurement_timeout, period, 3600.0);
   options.leader_timeout = reader.number("leader_timeout", options.leader_timeout, period, 3600.0);
+  options.max_future_stamp =
+      reader.number("max_future_stamp", options.max_future_stamp, 0.0, 3600.0);
   options.use_leader_broadcast = reader.boolean("use_leader_broadcast", false);
   options.measurement_frame = reader.text("measurement_frame", "");
   options.follower_frame = reader.text("follower_frame", options.follower_frame);
@@ -117,6 +119,10 @@ void FollowerNode::onMeasurement(const RelativeMeasurement::ConstPtr& msg) {
   if (!options_.measurement_frame.empty() && msg->header.frame_id != options_.measurement_frame) {
     rejectMeasurement("frame_id '" + msg->header.frame_id + "', expected '" +
                       options_.measurement_frame + "'");
+    return;
+  }
+  if (msg->header.stamp > ros::Time::now() + ros::Duration(options_.max_future_stamp)) {
+    rejectMeasurement("stamped in the future");
     return;
   }
   if (have_measurement_ && msg->header.stamp < measurement_stamp_) {

@@ -19,10 +19,11 @@ namespace projection_collision_avoidance {
 
 /// The follower node's own options (besides the scenario), read once from its private namespace.
 struct FollowerNodeOptions {
-  double measurement_timeout = 0.5;         ///< s; older measurements are reported stale
-  double leader_timeout = 0.5;              ///< s; older leader broadcasts are not used
-  bool use_leader_broadcast = false;        ///< subscribe to leader_broadcast for u_1
-  std::string measurement_frame;            ///< required frame_id of measurements ("" = any)
+  double measurement_timeout = 0.5;   ///< s; older measurements are reported stale
+  double leader_timeout = 0.5;        ///< s; older leader broadcasts are not used
+  double max_future_stamp = 0.1;      ///< s; measurements stamped after now + this are refused
+  bool use_leader_broadcast = false;  ///< subscribe to leader_broadcast for u_1
+  std::string measurement_frame;      ///< required frame_id of measurements ("" = any)
   std::string follower_frame = "follower";  ///< frame of the command, status and markers
   double marker_rate = 10.0;                ///< Hz
 };
