@@ -9,3 +9,7 @@ build_dir=${BUILD_DIR:-$root/build}
 cmake -S "$root" -B "$build_dir" -DCMAKE_BUILD_TYPE=Release \
   -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCATKIN_ENABLE_TESTING=ON >/dev/null
 make -C "$build_dir" -j"$(nproc)" all "$@"
+# catkin caches the devel environment at configure time, keeping only directories that exist
+# then: configure once more so that it includes the generated Python messages (the Python
+# rostests import them).
+cmake "$build_dir" >/dev/null
