@@ -48,6 +48,7 @@ class CollisionFreeEstimator {
       throw std::invalid_argument("CollisionFreeEstimator: model sizes do not fit the dimensions");
     }
     estimator_matrix_ = design.estimator_matrix;
+    state_matrix_ = design.parameters.model.A;
     input_matrix_ = design.parameters.model.B;
     observer_gain_ = design.parameters.estimator_gain;
     gamma_inverse_ = design.gamma_inverse;
@@ -76,8 +77,7 @@ class CollisionFreeEstimator {
   /// Projected derivative xi_hat' at @p estimate for the held input c (m/s).
   StateVector derivative(const StateVector& estimate, const StateVector& held_input,
                          bool* active) const {
-    const StateVector drift = estimator_matrix_ * estimate + held_input;
-    return projectDrift(constraint_, estimate, drift, gamma_inverse_, active);
+    return projectedDerivative(estimator_matrix_, estimate, held_input, active);
   }
 
   /// Advances the estimate over one control period with y and u_a held (15).
@@ -88,16 +88,38 @@ class CollisionFreeEstimator {
   /// @param substeps number of RK4 steps, >= 1
   EstimatorPeriodReport advance(const OutputVector& y, const InputVector& tracker_input,
                                 const StateVector& w, double period, int substeps) {
+    return integrate(estimator_matrix_, heldInput(y, tracker_input, w), period, substeps);
+  }
+
+  /// Predicts the estimate over one control period without a measurement (the fallback): the
+  /// model's own dynamics, projected, xi_hat' = Proj(A xi_hat + w), with w held. The
+  /// correction L (C xi_hat - y) of (11) is absent, so the estimate stays in Omega_1.
+  /// @param w held input drift (m/s): B (u_1 - u_2) with the leader's input as far as known
+  /// @param period control period T (s), > 0
+  /// @param substeps number of RK4 steps, >= 1
+  EstimatorPeriodReport predict(const StateVector& w, double period, int substeps) {
+    return integrate(state_matrix_, w, period, substeps);
+  }
+
+ private:
+  StateVector projectedDerivative(const StateMatrix& F, const StateVector& estimate,
+                                  const StateVector& held_input, bool* active) const {
+    const StateVector drift = F * estimate + held_input;
+    return projectDrift(constraint_, estimate, drift, gamma_inverse_, active);
+  }
+
+  /// RK4 over one period of xi_hat' = Proj(F xi_hat + c), c held; after each substep the
+  /// estimate is moved back into Omega_1 if the substep's truncation error left it outside.
+  EstimatorPeriodReport integrate(const StateMatrix& F, const StateVector& c, double period,
+                                  int substeps) {
     EstimatorPeriodReport report;
-    const StateVector held = heldInput(y, tracker_input, w);
+    bool* active = &report.projection_active;
     const double h = period / substeps;
     for (int i = 0; i < substeps; ++i) {
-      const StateVector k1 = derivative(estimate_, held, &report.projection_active);
-      const StateVector k2 =
-          derivative(estimate_ + (0.5 * h) * k1, held, &report.projection_active);
-      const StateVector k3 =
-          derivative(estimate_ + (0.5 * h) * k2, held, &report.projection_active);
-      const StateVector k4 = derivative(estimate_ + h * k3, held, &report.projection_active);
+      const StateVector k1 = projectedDerivative(F, estimate_, c, active);
+      const StateVector k2 = projectedDerivative(F, estimate_ + (0.5 * h) * k1, c, active);
+      const StateVector k3 = projectedDerivative(F, estimate_ + (0.5 * h) * k2, c, active);
+      const StateVector k4 = projectedDerivative(F, estimate_ + h * k3, c, active);
       estimate_ += (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
       const double correction = moveIntoBound(&estimate_);
       report.boundary_correction = std::max(report.boundary_correction, correction);
@@ -105,7 +127,6 @@ class CollisionFreeEstimator {
     return report;
   }
 
- private:
   /// Scales @p x onto the sphere of radius xi_max if it lies outside; returns the distance moved.
   double moveIntoBound(StateVector* x) const {
     const double radius = constraint_.hardRadius();
@@ -123,6 +144,7 @@ class CollisionFreeEstimator {
 
   BallConstraint constraint_;
   StateMatrix estimator_matrix_;      // A_c + L C
+  StateMatrix state_matrix_;          // A
   InputMatrix input_matrix_;          // B
   ObserverGainMatrix observer_gain_;  // L
   StateMatrix gamma_inverse_;         // Gamma^-1

@@ -22,6 +22,8 @@ struct ControllerDesign {
   Eigen::MatrixXd gamma_inverse;         ///< Gamma^-1
   double lyapunov_residual = 0.0;        ///< ||Gamma F + F^T Gamma + Q||_F / ||Q||_F
   Eigen::MatrixXd output_pseudoinverse;  ///< pinv(C), n x p, for the initial estimate
+  Eigen::MatrixXd fallback_gain;         ///< K_f, m x n (parameters.fallback_gain or its default)
+  Eigen::MatrixXd fallback_matrix;       ///< A - B K_f: the predicted xi' in the fallback
   /// Decay rate mu = lambda_min(Q) / (2 lambda_max(Gamma)) of Theorem 3.1: ||e(t)|| <=
   /// K_0 e^{-mu t / 2} ||e(0)|| with K_0 = sqrt(lambda_max(Gamma) / lambda_min(Gamma)).
   double estimator_decay_rate = 0.0;
@@ -30,7 +32,8 @@ struct ControllerDesign {
   /// Validates @p parameters and derives the design. Throws ParameterError with the key of the
   /// first failing check: sizes and finiteness of every matrix, alpha in [0, 1), epsilon > 0,
   /// d != 0 and A d = 0, control_rate > 0, substeps in [1, 1000], Q = Q^T > 0, and A_c,
-  /// A_c + L C, A_c - B G_e C Hurwitz (the message lists the eigenvalues).
+  /// A_c + L C, A_c - B G_e C Hurwitz (the message lists the eigenvalues), K_f of size m x n,
+  /// finite, with no eigenvalue of A - B K_f in the open right half-plane.
   static ControllerDesign create(const ControllerParameters& parameters);
 };
 

@@ -36,7 +36,16 @@ struct ControllerParameters {
   /// Bound on the command's norm ||u_2|| (m/s^2 for double integrators); a larger command is
   /// scaled onto it. Infinity: no bound.
   double acceleration_limit = std::numeric_limits<double>::infinity();
+  /// Gain K_f (m x n) of the fallback that runs while no measurement arrives:
+  /// u_2 = sat(u_ff + K_f xi_hat), xi_hat predicted without correction. Empty: the default,
+  /// [0, I / s] for double integrators (brake the relative velocity with a 1 s time constant),
+  /// zero otherwise.
+  Eigen::MatrixXd fallback_gain;
 };
+
+/// The default fallback gain of a k-axis double integrator: [0, k_v I], so that the fallback
+/// command u_2 = u_ff + k_v v_hat brakes the relative velocity v_1 - v_2 at the rate k_v (1/s).
+Eigen::MatrixXd doubleIntegratorFallbackGain(int axes, double velocity_gain);
 
 /// Gain matrix of a k-axis double integrator with C = I from per-axis natural frequency
 /// omega_n (rad/s) and damping zeta: row i is omega_i^2 on p_i and 2 zeta_i omega_i on v_i, so

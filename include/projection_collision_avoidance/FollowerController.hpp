@@ -14,10 +14,12 @@ struct FollowerControllerStatus {
   typename Dims::InputVector baseline_command;     ///< G y (2)
   typename Dims::InputVector tracker_command;      ///< u_a (19)
   typename Dims::InputVector feedforward_command;  ///< u_1 when shared into the command, else 0
+  typename Dims::InputVector fallback_command;     ///< K_f xi_hat in the fallback, else 0
   typename Dims::StateVector estimate;             ///< xi_hat used at this tick (m)
   double estimate_norm = 0.0;                      ///< ||xi_hat|| (m)
   double constraint_value = 0.0;                   ///< f(xi_hat) (13)
   bool command_saturated = false;    ///< the sum exceeded acceleration_limit and was scaled
+  bool fallback = false;             ///< this tick ran the fallback (no measurement)
   bool projection_active = false;    ///< the projection acted during the period that follows
   double boundary_correction = 0.0;  ///< see EstimatorPeriodReport (m)
 };
@@ -30,7 +32,8 @@ struct FollowerControllerStatus {
 /// computed from the current estimate, where sat() scales a vector longer than
 /// acceleration_limit onto it. The estimate is then integrated over [t, t + T] with y held and
 /// the augmentation that actually acts, u_2 - G y - u_ff (u_a when not saturated), so that its
-/// model of xi' stays that of the plant. A step allocates no memory.
+/// model of xi' stays that of the plant. Without a measurement stepFallback() brakes relative to
+/// the leader from the predicted estimate instead. A step allocates no memory.
 template <typename Dims>
 class FollowerController {
  public:
@@ -46,11 +49,13 @@ class FollowerController {
         input_matrix_(design.parameters.model.B),
         output_matrix_(design.parameters.model.C),
         baseline_gain_(design.parameters.baseline_gain),
-        output_pseudoinverse_(design.output_pseudoinverse) {
+        output_pseudoinverse_(design.output_pseudoinverse),
+        fallback_gain_(design.fallback_gain) {
     status_.command = InputVector::Zero(design.parameters.model.inputDimension());
     status_.baseline_command = status_.command;
     status_.tracker_command = status_.command;
     status_.feedforward_command = status_.command;
+    status_.fallback_command = status_.command;
     status_.estimate = estimator_.estimate();
   }
 
@@ -66,6 +71,22 @@ class FollowerController {
   const FollowerControllerStatus<Dims>& step(const OutputVector& y,
                                              const InputVector& leader_input) {
     return advance(y, leader_input, true);
+  }
+
+  /// One control period without a measurement: the fallback. The command brakes relative to
+  /// the leader from the estimate, which is predicted by the model alone and stays in Omega_1:
+  ///   u_2 = sat(u_ff + K_f xi_hat),   xi_hat' = Proj(A xi_hat + B (u_1m - u_2)),
+  /// with u_ff and u_1m the leader input as shared into the command and the estimator (0 when
+  /// unknown). For the default K_f = [0, k_v I] of a double integrator the predicted relative
+  /// velocity decays as e^{-k_v t} and the relative position comes to rest. Before any
+  /// measurement the estimate is the one the next step() would replace, zero.
+  const FollowerControllerStatus<Dims>& stepFallback() {
+    return fallback(InputVector::Zero(input_matrix_.cols()), false);
+  }
+
+  /// The fallback with the leader's current input u_1 (see stepFallback()).
+  const FollowerControllerStatus<Dims>& stepFallback(const InputVector& leader_input) {
+    return fallback(leader_input, true);
   }
 
   /// Forgets the estimate; the next step initialises it as configured.
@@ -107,30 +128,74 @@ class FollowerController {
     status_.constraint_value = estimator_.constraint().value(estimate);
     status_.baseline_command = baseline_gain_ * y;
     status_.tracker_command = tracker_.command(y, estimated_output);
-    status_.feedforward_command.setZero();
-    if (leader_input_known && p.leader_input_in_command) {
-      status_.feedforward_command = leader_input;
-    }
+    status_.fallback_command.setZero();
+    status_.fallback = false;
+    setFeedforward(leader_input, leader_input_known);
     status_.command =
         status_.baseline_command + status_.tracker_command + status_.feedforward_command;
-    const double norm = status_.command.norm();
-    status_.command_saturated = norm > p.acceleration_limit;
+    saturateCommand();
     InputVector acting_augmentation = status_.tracker_command;
     if (status_.command_saturated) {
-      status_.command *= p.acceleration_limit / norm;
       acting_augmentation =
           status_.command - status_.baseline_command - status_.feedforward_command;
     }
 
-    StateVector known_drift = StateVector::Zero(input_matrix_.rows());
-    if (leader_input_known && p.leader_input_in_estimator) {
-      known_drift = input_matrix_ * (leader_input - status_.feedforward_command);
-    }
+    const StateVector known_drift = knownDrift(leader_input, leader_input_known);
     const EstimatorPeriodReport report = estimator_.advance(y, acting_augmentation, known_drift,
                                                             design_.period, p.estimator_substeps);
     status_.projection_active = report.projection_active;
     status_.boundary_correction = report.boundary_correction;
     return status_;
+  }
+
+  const FollowerControllerStatus<Dims>& fallback(const InputVector& leader_input,
+                                                 bool leader_input_known) {
+    const ControllerParameters& p = design_.parameters;
+    const StateVector& estimate = estimator_.estimate();
+    status_.estimate = estimate;
+    status_.estimate_norm = estimate.norm();
+    status_.constraint_value = estimator_.constraint().value(estimate);
+    status_.baseline_command.setZero();
+    status_.tracker_command.setZero();
+    status_.fallback = true;
+    setFeedforward(leader_input, leader_input_known);
+    status_.fallback_command = fallback_gain_ * estimate;
+    status_.command = status_.feedforward_command + status_.fallback_command;
+    saturateCommand();
+
+    // xi' = A xi + B (u_1 - u_ff) - B (u_2 - u_ff), with u_1 - u_ff modelled as in step().
+    const StateVector drift = knownDrift(leader_input, leader_input_known) -
+                              input_matrix_ * (status_.command - status_.feedforward_command);
+    const EstimatorPeriodReport report =
+        estimator_.predict(drift, design_.period, p.estimator_substeps);
+    status_.projection_active = report.projection_active;
+    status_.boundary_correction = report.boundary_correction;
+    return status_;
+  }
+
+  /// w = B (u_1 - u_ff) when the leader's input is shared into the estimator, else 0 (m/s).
+  StateVector knownDrift(const InputVector& leader_input, bool leader_input_known) const {
+    if (leader_input_known && design_.parameters.leader_input_in_estimator) {
+      return input_matrix_ * (leader_input - status_.feedforward_command);
+    }
+    return StateVector::Zero(input_matrix_.rows());
+  }
+
+  void setFeedforward(const InputVector& leader_input, bool leader_input_known) {
+    status_.feedforward_command.setZero();
+    if (leader_input_known && design_.parameters.leader_input_in_command) {
+      status_.feedforward_command = leader_input;
+    }
+  }
+
+  /// Scales status_.command onto acceleration_limit when it is longer.
+  void saturateCommand() {
+    const double limit = design_.parameters.acceleration_limit;
+    const double norm = status_.command.norm();
+    status_.command_saturated = norm > limit;
+    if (status_.command_saturated) {
+      status_.command *= limit / norm;
+    }
   }
 
   ControllerDesign design_;
@@ -140,6 +205,7 @@ class FollowerController {
   typename Dims::OutputMatrix output_matrix_;               // C
   typename Dims::FeedbackGainMatrix baseline_gain_;         // G
   typename Dims::ObserverGainMatrix output_pseudoinverse_;  // pinv(C)
+  typename Dims::StateGainMatrix fallback_gain_;            // K_f
   FollowerControllerStatus<Dims> status_;
   bool initialized_ = false;
 };

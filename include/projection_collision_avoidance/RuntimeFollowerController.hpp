@@ -17,10 +17,12 @@ struct RuntimeFollowerStatus {
   Eigen::VectorXd baseline_command;     ///< G y (2)
   Eigen::VectorXd tracker_command;      ///< u_a (19)
   Eigen::VectorXd feedforward_command;  ///< u_1 when shared into the command
+  Eigen::VectorXd fallback_command;     ///< K_f xi_hat in the fallback, else 0
   Eigen::VectorXd estimate;             ///< xi_hat used at this tick (m)
   double estimate_norm = 0.0;           ///< ||xi_hat|| (m)
   double constraint_value = 0.0;        ///< f(xi_hat) (13)
   bool command_saturated = false;       ///< the command was scaled onto acceleration_limit
+  bool fallback = false;                ///< this tick ran the fallback (no measurement)
   bool projection_active = false;
   double boundary_correction = 0.0;  ///< (m)
 };
@@ -40,6 +42,12 @@ class RuntimeFollowerController {
   /// One control period with the leader's input u_1 (inputDimension() entries).
   const RuntimeFollowerStatus& step(const Eigen::Ref<const Eigen::VectorXd>& y,
                                     const Eigen::Ref<const Eigen::VectorXd>& leader_input);
+
+  /// One control period without a measurement (see FollowerController::stepFallback()).
+  const RuntimeFollowerStatus& stepFallback();
+
+  /// The fallback with the leader's input u_1 (inputDimension() entries).
+  const RuntimeFollowerStatus& stepFallback(const Eigen::Ref<const Eigen::VectorXd>& leader_input);
 
   /// Replaces the parameters (for example from dynamic_reconfigure) and keeps the estimate,
   /// moved into the new Omega_1. Throws std::invalid_argument if the model's sizes change.

@@ -42,6 +42,7 @@ struct Dimensions {
   using OutputMatrix = BoundedMatrix<P, N, kMaxOutputs, kMaxStates>;        ///< p x n: C
   using FeedbackGainMatrix = BoundedMatrix<M, P, kMaxInputs, kMaxOutputs>;  ///< m x p: G, G_e
   using ObserverGainMatrix = BoundedMatrix<N, P, kMaxStates, kMaxOutputs>;  ///< n x p: L, pinv(C)
+  using StateGainMatrix = BoundedMatrix<M, N, kMaxInputs, kMaxStates>;      ///< m x n: K_f
 };
 
 /// Double integrator on one axis: x = [p; v], u = acceleration, y = x.

@@ -16,6 +16,7 @@ namespace {
 
 constexpr int kMaxEstimatorSubsteps = 1000;
 constexpr double kRelativeTolerance = 1e-9;
+constexpr double kDefaultFallbackVelocityGain = 1.0;  // 1/s
 
 void requireHurwitz(const std::string& key, const std::string& name, const Eigen::MatrixXd& M) {
   if (!isHurwitz(M)) {
@@ -96,6 +97,17 @@ Eigen::MatrixXd doubleIntegratorGain(const Eigen::VectorXd& natural_frequency,
   return gain;
 }
 
+Eigen::MatrixXd doubleIntegratorFallbackGain(int axes, double velocity_gain) {
+  const std::string key = "controller.fallback.velocity_gain";
+  if (!(velocity_gain > 0.0) || !std::isfinite(velocity_gain)) {
+    throw ParameterError(key,
+                         "must be positive and finite (1/s), got " + std::to_string(velocity_gain));
+  }
+  Eigen::MatrixXd gain = Eigen::MatrixXd::Zero(axes, 2 * axes);
+  gain.rightCols(axes).diagonal().setConstant(velocity_gain);
+  return gain;
+}
+
 ControllerDesign ControllerDesign::create(const ControllerParameters& parameters) {
   const ControllerParameters& p = parameters;
   validateAgentModel(p.model);
@@ -149,6 +161,23 @@ ControllerDesign ControllerDesign::create(const ControllerParameters& parameters
       Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(p.lyapunov_weight).eigenvalues().minCoeff();
   design.estimator_decay_rate = q_min / (2.0 * gamma_max);
   design.estimator_overshoot = std::sqrt(gamma_max / gamma_min);
+
+  design.fallback_gain = p.fallback_gain;
+  if (design.fallback_gain.size() == 0) {
+    design.fallback_gain = p.model.isDoubleIntegrator()
+                               ? doubleIntegratorFallbackGain(p.model.double_integrator_axes,
+                                                              kDefaultFallbackVelocityGain)
+                               : Eigen::MatrixXd::Zero(m, n);
+  }
+  detail::requireMatrix("controller.fallback.gain", design.fallback_gain, m, n);
+  design.fallback_matrix = A - B * design.fallback_gain;
+  const double growth = eigenvalues(design.fallback_matrix).real().maxCoeff();
+  if (growth > kRelativeTolerance * (1.0 + design.fallback_matrix.norm())) {
+    throw ParameterError(
+        "controller.fallback.gain",
+        "A - B K_f has an eigenvalue in the right half-plane; its eigenvalues are " +
+            formatEigenvalues(eigenvalues(design.fallback_matrix)));
+  }
 
   design.output_pseudoinverse = C.completeOrthogonalDecomposition().pseudoInverse();
   design.period = 1.0 / p.control_rate;

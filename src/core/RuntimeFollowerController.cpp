@@ -14,10 +14,12 @@ void copyStatus(const FollowerControllerStatus<Dims>& from, RuntimeFollowerStatu
   to->baseline_command = from.baseline_command;
   to->tracker_command = from.tracker_command;
   to->feedforward_command = from.feedforward_command;
+  to->fallback_command = from.fallback_command;
   to->estimate = from.estimate;
   to->estimate_norm = from.estimate_norm;
   to->constraint_value = from.constraint_value;
   to->command_saturated = from.command_saturated;
+  to->fallback = from.fallback;
   to->projection_active = from.projection_active;
   to->boundary_correction = from.boundary_correction;
 }
@@ -39,6 +41,7 @@ RuntimeFollowerController::RuntimeFollowerController(const ControllerDesign& des
   status_.baseline_command = Eigen::VectorXd::Zero(m);
   status_.tracker_command = Eigen::VectorXd::Zero(m);
   status_.feedforward_command = Eigen::VectorXd::Zero(m);
+  status_.fallback_command = Eigen::VectorXd::Zero(m);
   status_.estimate = Eigen::VectorXd::Zero(n);
 }
 
@@ -63,6 +66,24 @@ const RuntimeFollowerStatus& RuntimeFollowerController::step(
         const typename Controller::OutputVector measurement = y;
         const typename Controller::InputVector input = leader_input;
         copyStatus(controller.step(measurement, input), &status_);
+      },
+      controller_);
+  return status_;
+}
+
+const RuntimeFollowerStatus& RuntimeFollowerController::stepFallback() {
+  std::visit([&](auto& controller) { copyStatus(controller.stepFallback(), &status_); },
+             controller_);
+  return status_;
+}
+
+const RuntimeFollowerStatus& RuntimeFollowerController::stepFallback(
+    const Eigen::Ref<const Eigen::VectorXd>& leader_input) {
+  std::visit(
+      [&](auto& controller) {
+        using Controller = std::decay_t<decltype(controller)>;
+        const typename Controller::InputVector input = leader_input;
+        copyStatus(controller.stepFallback(input), &status_);
       },
       controller_);
   return status_;

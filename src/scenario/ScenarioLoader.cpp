@@ -173,6 +173,23 @@ ControllerParameters readController(detail::YamlReader& reader, const AgentModel
   if (controller.has("acceleration_limit")) {
     result.acceleration_limit = controller.number("acceleration_limit");
   }
+  if (controller.has("fallback")) {
+    detail::YamlReader fallback = controller.map("fallback");
+    if (fallback.has("gain") && fallback.has("velocity_gain")) {
+      throw ParameterError(fallback.key("gain"), "give gain or velocity_gain, not both");
+    }
+    if (fallback.has("gain")) {
+      result.fallback_gain = fallback.matrix("gain", m, n);
+    } else if (fallback.has("velocity_gain")) {
+      if (!model.isDoubleIntegrator()) {
+        throw ParameterError(fallback.key("velocity_gain"),
+                             "needs a double_integrator model; give gain instead");
+      }
+      result.fallback_gain = doubleIntegratorFallbackGain(model.double_integrator_axes,
+                                                          fallback.number("velocity_gain"));
+    }
+    fallback.finish();
+  }
   if (controller.has("leader_information")) {
     detail::YamlReader sharing = controller.map("leader_information");
     if (sharing.has("command")) {

@@ -59,8 +59,9 @@ void free(void* pointer) { __libc_free(pointer); }
 namespace projection_collision_avoidance {
 namespace {
 
-/// Runs @p steps control steps on measurements inside and far outside the bound (so both the
-/// plain and the projected drift run) and returns the allocations counted during them.
+/// Runs @p steps control steps (each with and without the leader's input, and as many fallback
+/// steps) on measurements inside and far outside the bound (so both the plain and the projected
+/// drift run) and returns the allocations counted during them.
 template <typename Dims>
 long allocationsDuringSteps(const ControllerDesign& design, int steps) {
   FollowerController<Dims> controller(design);
@@ -73,6 +74,8 @@ long allocationsDuringSteps(const ControllerDesign& design, int steps) {
     y.setConstant((k / 50) % 2 == 0 ? 0.2 : 7.0);
     sink += controller.step(y).command(0);
     sink += controller.step(y, u1).command(0);
+    sink += controller.stepFallback().command(0);
+    sink += controller.stepFallback(u1).command(0);
   }
   const long after = g_allocations.load();
   EXPECT_TRUE(std::isfinite(sink));
@@ -120,6 +123,8 @@ TEST(NoAllocation, ControlStepsOfTheRuntimeController) {
       y.setConstant((k / 50) % 2 == 0 ? 0.2 : 7.0);
       controller.step(y);
       controller.step(y, u1);
+      controller.stepFallback();
+      controller.stepFallback(u1);
     }
     EXPECT_EQ(g_allocations.load() - before, 0) << axes << " axes";
   }
