@@ -26,7 +26,11 @@ FollowerNodeOptions readOptions(NodeOptionReader& reader, const ControllerParame
       reader.number("max_future_stamp", options.max_future_stamp, 0.0, 3600.0);
   options.use_leader_broadcast = reader.boolean("use_leader_broadcast", false);
   options.measurement_frame = reader.text("measurement_frame", "");
+  options.leader_broadcast_frame = reader.text("leader_broadcast_frame", "");
   options.follower_frame = reader.text("follower_frame", options.follower_frame);
+  if (options.follower_frame.empty()) {
+    throw ParameterError("~follower_frame", "must not be empty");
+  }
   options.marker_rate = reader.number("marker_rate", options.marker_rate, 0.0, p.control_rate);
   return options;
 }
@@ -63,10 +67,16 @@ FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
       parameters_(loadDoubleIntegratorScenario(private_nh).controller),
       controller_(ControllerDesign::create(parameters_)),
       axes_(parameters_.model.double_integrator_axes),
+      measurement_guard_("relative_measurement", "", 0.0),
+      leader_guard_("leader_broadcast", "", 0.0),
       diagnostics_(nh, private_nh),
       reconfigure_server_(reconfigure_mutex_, private_nh) {
   NodeOptionReader reader(private_nh);
   options_ = readOptions(reader, parameters_);
+  measurement_guard_ =
+      InputGuard("relative_measurement", options_.measurement_frame, options_.max_future_stamp);
+  leader_guard_ =
+      InputGuard("leader_broadcast", options_.leader_broadcast_frame, options_.max_future_stamp);
   const std::string name = ros::this_node::getName();
   echoScenario(name, private_nh);
   reader.echo(name);
@@ -78,10 +88,8 @@ FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   marker_publisher_ = nh_.advertise<visualization_msgs::MarkerArray>("markers", 2);
   measurement_subscriber_ = nh_.subscribe("relative_measurement", 10, &FollowerNode::onMeasurement,
                                           this, ros::TransportHints().tcpNoDelay());
-  if (options_.use_leader_broadcast) {
-    leader_subscriber_ =
-        nh_.subscribe("leader_broadcast", 10, &FollowerNode::onLeaderBroadcast, this);
-  }
+  leader_subscriber_ =
+      nh_.subscribe("leader_broadcast", 10, &FollowerNode::onLeaderBroadcast, this);
 
   diagnostics_.setHardwareID(options_.follower_frame);
   diagnostics_.add("follower controller", this, &FollowerNode::diagnose);
@@ -90,83 +98,104 @@ FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   reconfigure_server_.setCallback(
       [this](FollowerConfig& config, uint32_t level) { onReconfigure(config, level); });
 
-  timer_ = nh_.createTimer(ros::Duration(1.0 / parameters_.control_rate),
-                           &FollowerNode::onControlTick, this);
+  ros::TimerOptions timer_options(
+      ros::Duration(1.0 / parameters_.control_rate),
+      [this](const ros::TimerEvent& event) { onControlTick(event); }, &control_queue_);
+  timer_ = nh_.createTimer(timer_options);
+  control_spinner_ = std::make_unique<ros::AsyncSpinner>(1, &control_queue_);
+  control_spinner_->start();
   ROS_INFO_STREAM(name << ": running at " << parameters_.control_rate << " Hz, " << axes_
                        << " axes, xi_max " << controller_.design().xi_max << " m");
 }
 
-void FollowerNode::rejectMeasurement(const std::string& why) {
-  ++rejected_measurements_;
-  if (why != last_rejection_) {
-    ROS_WARN_STREAM(ros::this_node::getName() << ": measurement rejected: " << why);
-    last_rejection_ = why;
-  } else {
-    ROS_WARN_STREAM_THROTTLE(5.0, ros::this_node::getName()
-                                      << ": measurements rejected (" << rejected_measurements_
-                                      << " so far): " << why);
-  }
+FollowerNode::~FollowerNode() {
+  timer_.stop();
+  control_spinner_->stop();
 }
 
 void FollowerNode::onMeasurement(const RelativeMeasurement::ConstPtr& msg) {
   const std::lock_guard<std::mutex> lock(mutex_);
+  if (!measurement_guard_.checkHeader(msg->header, ros::Time::now())) {
+    return;
+  }
   std::string why;
   Eigen::VectorXd state;
   if (!relativeStateFromMsg(*msg, axes_, &state, &why)) {
-    rejectMeasurement(why);
-    return;
-  }
-  if (!options_.measurement_frame.empty() && msg->header.frame_id != options_.measurement_frame) {
-    rejectMeasurement("frame_id '" + msg->header.frame_id + "', expected '" +
-                      options_.measurement_frame + "'");
-    return;
-  }
-  if (msg->header.stamp > ros::Time::now() + ros::Duration(options_.max_future_stamp)) {
-    rejectMeasurement("stamped in the future");
-    return;
-  }
-  if (have_measurement_ && msg->header.stamp < measurement_stamp_) {
-    rejectMeasurement("stamped before the last accepted measurement");
+    measurement_guard_.reject(why);
     return;
   }
   relative_state_ = state;
-  measurement_stamp_ = msg->header.stamp;
-  have_measurement_ = true;
-  last_rejection_.clear();
+  measurement_guard_.accept(msg->header.stamp);
 }
 
 void FollowerNode::onLeaderBroadcast(const LeaderBroadcast::ConstPtr& msg) {
   const std::lock_guard<std::mutex> lock(mutex_);
-  const Eigen::VectorXd input = toEigen(msg->input);
-  if (input.size() != axes_ || !input.allFinite()) {
-    ROS_WARN_STREAM_THROTTLE(5.0, ros::this_node::getName()
-                                      << ": leader broadcast ignored: input must have " << axes_
-                                      << " finite entries");
+  if (!leader_guard_.checkHeader(msg->header, ros::Time::now())) {
+    return;
+  }
+  std::string why;
+  Eigen::VectorXd input;
+  if (!leaderInputFromMsg(*msg, axes_, &input, &why)) {
+    leader_guard_.reject(why);
     return;
   }
   leader_input_ = input;
-  leader_stamp_ = msg->header.stamp;
-  have_leader_input_ = true;
+  leader_guard_.accept(msg->header.stamp);
+}
+
+void FollowerNode::logModeChange(FollowerMode mode) {
+  const std::string name = ros::this_node::getName();
+  switch (mode) {
+    case FollowerMode::kTracking:
+      ROS_INFO_STREAM(name << ": tracking");
+      break;
+    case FollowerMode::kLeaderLost:
+      ROS_WARN_STREAM(name << ": leader broadcast older than ~leader_timeout ("
+                           << options_.leader_timeout
+                           << " s): running on the relative measurement alone");
+      break;
+    case FollowerMode::kMeasurementLost:
+      ROS_ERROR_STREAM(name << ": relative measurement older than ~measurement_timeout ("
+                            << options_.measurement_timeout
+                            << " s): braking relative to the leader until it returns");
+      break;
+    case FollowerMode::kWaiting:
+      break;
+  }
 }
 
 void FollowerNode::onControlTick(const ros::TimerEvent& /*event*/) {
   const std::lock_guard<std::mutex> lock(mutex_);
   const ros::Time now = ros::Time::now();
-  if (!have_measurement_) {
+  FollowerInputAges ages;
+  ages.have_measurement = measurement_guard_.haveAccepted();
+  ages.measurement_age = (now - measurement_guard_.lastStamp()).toSec();
+  ages.have_leader = leader_guard_.haveAccepted();
+  ages.leader_age = (now - leader_guard_.lastStamp()).toSec();
+  const FollowerMode mode = selectFollowerMode(
+      ages, FollowerTimeouts{options_.measurement_timeout, options_.leader_timeout});
+  if (mode != mode_) {
+    logModeChange(mode);
+    mode_ = mode;
+  }
+  if (mode == FollowerMode::kWaiting) {
     diagnostics_.update();
     return;
   }
-  const bool fresh = (now - measurement_stamp_).toSec() <= options_.measurement_timeout;
+  leader_fresh_ = ages.have_leader && ages.leader_age <= options_.leader_timeout;
+  const bool use_leader_input = options_.use_leader_broadcast && leader_fresh_;
   const Eigen::VectorXd xi = relative_state_ - parameters_.separation;
-  const Eigen::VectorXd y = parameters_.model.C * xi;
-  const bool leader_fresh = options_.use_leader_broadcast && have_leader_input_ &&
-                            (now - leader_stamp_).toSec() <= options_.leader_timeout;
-  const RuntimeFollowerStatus& status =
-      leader_fresh ? controller_.step(y, leader_input_) : controller_.step(y);
-  command_publisher_.publish(toAccelMsg(status.command, now, options_.follower_frame));
-  last_tick_fresh_ = fresh;
+  const RuntimeFollowerStatus* status = nullptr;
+  if (mode == FollowerMode::kMeasurementLost) {
+    status =
+        use_leader_input ? &controller_.stepFallback(leader_input_) : &controller_.stepFallback();
+  } else {
+    const Eigen::VectorXd y = parameters_.model.C * xi;
+    status = use_leader_input ? &controller_.step(y, leader_input_) : &controller_.step(y);
+  }
+  command_publisher_.publish(toAccelMsg(status->command, now, options_.follower_frame));
   last_xi_norm_ = xi.norm();
-  publishStatus(now, xi, fresh);
+  publishStatus(now, xi, ages.measurement_age);
   const long ticks_per_marker =
       options_.marker_rate > 0.0
           ? std::max(1L, std::lround(parameters_.control_rate / options_.marker_rate))
@@ -178,14 +207,21 @@ void FollowerNode::onControlTick(const ros::TimerEvent& /*event*/) {
   diagnostics_.update();
 }
 
-void FollowerNode::publishStatus(const ros::Time& now, const Eigen::VectorXd& xi, bool fresh) {
+void FollowerNode::publishStatus(const ros::Time& now, const Eigen::VectorXd& xi,
+                                 double measurement_age) {
   const RuntimeFollowerStatus& s = controller_.status();
   const ControllerDesign& design = controller_.design();
   FollowerStatus msg;
   msg.header.stamp = now;
   msg.header.frame_id = options_.follower_frame;
-  msg.measurement_fresh = fresh;
-  msg.rejected_measurements = rejected_measurements_;
+  msg.mode = static_cast<uint8_t>(mode_);
+  msg.mode_name = toString(mode_);
+  msg.fallback = s.fallback;
+  msg.measurement_fresh = mode_ != FollowerMode::kMeasurementLost;
+  msg.measurement_age = measurement_age;
+  msg.rejected_measurements = measurement_guard_.rejected();
+  msg.leader_fresh = leader_fresh_;
+  msg.rejected_leader_broadcasts = leader_guard_.rejected();
   msg.xi = toStdVector(xi);
   msg.xi_hat = toStdVector(s.estimate);
   msg.xi_norm = xi.norm();
@@ -196,11 +232,13 @@ void FollowerNode::publishStatus(const ros::Time& now, const Eigen::VectorXd& xi
   msg.constraint = s.constraint_value;
   msg.projection_active = s.projection_active;
   msg.command_saturated = s.command_saturated;
+  msg.acceleration_limit = parameters_.acceleration_limit;
   msg.tracker_enabled = parameters_.tracker_enabled;
   msg.command = toStdVector(s.command);
   msg.baseline_command = toStdVector(s.baseline_command);
   msg.tracker_command = toStdVector(s.tracker_command);
   msg.feedforward_command = toStdVector(s.feedforward_command);
+  msg.fallback_command = toStdVector(s.fallback_command);
   msg.separation = relative_state_.head(axes_).norm();
   msg.perimeter = design.perimeter;
   status_publisher_.publish(msg);
@@ -229,18 +267,26 @@ void FollowerNode::publishMarkers(const ros::Time& now, const Eigen::VectorXd& x
       sphereMarker(frame, now, "slot", 0, toVector3(slot), 0.3, 0.8F, 0.8F, 0.8F, 0.9F);
   slot_marker.type = visualization_msgs::Marker::CUBE;
   markers.markers.push_back(slot_marker);
-  // The follower where the CF estimate puts it: p_2 + (xi - xi_hat)_p.
+  // The follower where the CF estimate puts it: p_2 + (xi - xi_hat)_p. Grey in the fallback,
+  // where xi is the last measured one and xi_hat a prediction.
+  const bool fallback = mode_ == FollowerMode::kMeasurementLost;
   const Eigen::VectorXd ghost = (xi - s.estimate).head(axes_);
-  markers.markers.push_back(
-      sphereMarker(frame, now, "cf_estimate", 0, toVector3(ghost), 0.5, 1.0F, 0.55F, 0.0F, 0.45F));
-  // ||xi|| against xi_max, as text above the follower.
-  const float shade = xi.norm() > design.xi_max ? 0.2F : 1.0F;  // red outside the bound
+  markers.markers.push_back(sphereMarker(frame, now, "cf_estimate", 0, toVector3(ghost), 0.5,
+                                         fallback ? 0.5F : 1.0F, fallback ? 0.5F : 0.55F,
+                                         fallback ? 0.5F : 0.0F, 0.45F));
+  // ||xi|| against xi_max, as text above the follower; the mode unless tracking.
+  const float shade = xi.norm() > design.xi_max || fallback ? 0.2F : 1.0F;  // red: trouble
   visualization_msgs::Marker text = sphereMarker(
       frame, now, "bound", 0, Eigen::Vector3d(0.0, 0.0, 1.2), 0.35, 1.0F, shade, shade, 1.0F);
   text.type = visualization_msgs::Marker::TEXT_VIEW_FACING;
   std::ostringstream label;
   label << std::fixed << std::setprecision(2) << "|xi| " << xi.norm() << " / xi_max "
         << design.xi_max << " m";
+  if (fallback) {
+    label << "\nMEASUREMENT LOST: braking";
+  } else if (mode_ == FollowerMode::kLeaderLost) {
+    label << "\nleader broadcast lost";
+  }
   text.text = label.str();
   markers.markers.push_back(text);
   marker_publisher_.publish(markers);
@@ -248,29 +294,51 @@ void FollowerNode::publishMarkers(const ros::Time& now, const Eigen::VectorXd& x
 
 void FollowerNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   // Called from onControlTick with mutex_ held.
+  using diagnostic_msgs::DiagnosticStatus;
   const ControllerDesign& design = controller_.design();
-  if (!have_measurement_) {
-    status.summary(diagnostic_msgs::DiagnosticStatus::ERROR, "no relative measurement yet");
-  } else if (last_xi_norm_ > design.xi_max) {
-    status.summary(diagnostic_msgs::DiagnosticStatus::ERROR, "relative error outside xi_max");
-  } else if (!last_tick_fresh_) {
-    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "relative measurement stale");
-  } else if (!last_rejection_.empty()) {
-    status.summary(diagnostic_msgs::DiagnosticStatus::WARN,
-                   "rejecting measurements: " + last_rejection_);
-  } else {
-    status.summary(diagnostic_msgs::DiagnosticStatus::OK, "tracking");
+  const RuntimeFollowerStatus& s = controller_.status();
+  switch (mode_) {
+    case FollowerMode::kWaiting:
+      status.summary(DiagnosticStatus::ERROR, "no relative measurement yet");
+      break;
+    case FollowerMode::kMeasurementLost:
+      status.summary(DiagnosticStatus::ERROR, "relative measurement lost: braking fallback");
+      break;
+    case FollowerMode::kLeaderLost:
+      status.summary(DiagnosticStatus::WARN, "leader broadcast lost: running without u_1");
+      break;
+    case FollowerMode::kTracking:
+      status.summary(DiagnosticStatus::OK, "tracking");
+      break;
   }
+  if (mode_ != FollowerMode::kWaiting && last_xi_norm_ > design.xi_max) {
+    status.mergeSummary(DiagnosticStatus::ERROR, "relative error outside xi_max");
+  }
+  if (!measurement_guard_.lastRejection().empty()) {
+    status.mergeSummary(DiagnosticStatus::WARN,
+                        "rejecting measurements: " + measurement_guard_.lastRejection());
+  }
+  if (!leader_guard_.lastRejection().empty()) {
+    status.mergeSummary(DiagnosticStatus::WARN,
+                        "rejecting leader broadcasts: " + leader_guard_.lastRejection());
+  }
+  status.add("mode", toString(mode_));
   status.add("xi_norm (m)", last_xi_norm_);
   status.add("xi_max (m)", design.xi_max);
   status.add("margin (m)", design.xi_max - last_xi_norm_);
-  status.add("estimate_norm (m)", controller_.status().estimate_norm);
-  status.add("projection_active", controller_.status().projection_active);
-  status.add("command_saturated", controller_.status().command_saturated);
+  status.add("estimate_norm (m)", s.estimate_norm);
+  status.add("projection_active", s.projection_active);
+  status.add("command_saturated", s.command_saturated);
+  status.add("acceleration_limit (m/s^2)", parameters_.acceleration_limit);
   status.add("tracker_enabled", parameters_.tracker_enabled);
-  status.add("rejected_measurements", rejected_measurements_);
-  status.add("measurement_age (s)",
-             have_measurement_ ? (ros::Time::now() - measurement_stamp_).toSec() : -1.0);
+  status.add("rejected_measurements", measurement_guard_.rejected());
+  status.add("rejected_leader_broadcasts", leader_guard_.rejected());
+  const ros::Time now = ros::Time::now();
+  status.add("measurement_age (s)", measurement_guard_.haveAccepted()
+                                        ? (now - measurement_guard_.lastStamp()).toSec()
+                                        : -1.0);
+  status.add("leader_age (s)",
+             leader_guard_.haveAccepted() ? (now - leader_guard_.lastStamp()).toSec() : -1.0);
 }
 
 FollowerConfig FollowerNode::configOf(const ControllerParameters& parameters) const {

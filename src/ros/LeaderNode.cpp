@@ -46,16 +46,23 @@ LeaderNode::LeaderNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
 
 void LeaderNode::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
   const std::lock_guard<std::mutex> lock(mutex_);
+  if (!odometry_guard_.checkHeader(msg->header, ros::Time::now())) {
+    return;
+  }
+  if (msg->child_frame_id != options_.leader_frame) {
+    odometry_guard_.reject("child_frame_id '" + msg->child_frame_id + "', expected '" +
+                           options_.leader_frame + "'");
+    return;
+  }
   Eigen::VectorXd state;
   if (!stateFromOdometryMsg(*msg, axes_, &state)) {
-    ++rejected_odometry_;
-    ROS_WARN_STREAM_THROTTLE(5.0, name_ << ": leader/odom rejected (" << rejected_odometry_
-                                        << " so far): non-finite position or velocity");
+    odometry_guard_.reject("non-finite position or velocity");
     return;
   }
   odometry_ = *msg;
   state_ = state;
   have_odometry_ = true;
+  odometry_guard_.accept(msg->header.stamp);
 }
 
 void LeaderNode::onTick(const ros::TimerEvent& event) {
@@ -72,6 +79,7 @@ void LeaderNode::onTick(const ros::TimerEvent& event) {
     ROS_WARN_STREAM(name_ << ": ROS time went back from " << last_stamp_.toSec() << " s to "
                           << stamp.toSec() << " s");
     have_odometry_ = false;
+    odometry_guard_ = InputGuard("leader/odom", "", kMaxFutureStamp);
   }
   last_stamp_ = stamp;
   if (!started_) {

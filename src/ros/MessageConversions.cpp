@@ -40,6 +40,30 @@ bool relativeStateFromMsg(const RelativeMeasurement& msg, int axes, Eigen::Vecto
   return true;
 }
 
+bool leaderInputFromMsg(const LeaderBroadcast& msg, int axes, Eigen::VectorXd* input,
+                        std::string* why) {
+  const auto size = [](const std::vector<double>& field) { return std::to_string(field.size()); };
+  const auto axes_entries = static_cast<std::size_t>(axes);
+  if (msg.position.size() != axes_entries || msg.velocity.size() != axes_entries ||
+      msg.input.size() != axes_entries ||
+      (!msg.disturbance.empty() && msg.disturbance.size() != 2 * axes_entries)) {
+    *why = "position, velocity and input must have " + std::to_string(axes) +
+           " entries and disturbance 0 or " + std::to_string(2 * axes) + ", got " +
+           size(msg.position) + ", " + size(msg.velocity) + ", " + size(msg.input) + " and " +
+           size(msg.disturbance);
+    return false;
+  }
+  for (const std::vector<double>* field :
+       {&msg.position, &msg.velocity, &msg.input, &msg.disturbance}) {
+    if (!toEigen(*field).allFinite()) {
+      *why = "non-finite entry";
+      return false;
+    }
+  }
+  *input = toEigen(msg.input);
+  return true;
+}
+
 RelativeMeasurement toRelativeMeasurementMsg(const Eigen::Ref<const Eigen::VectorXd>& state,
                                              const ros::Time& stamp, const std::string& frame) {
   const Eigen::Index axes = state.size() / 2;

@@ -53,18 +53,23 @@ PlantNodeOptions readOptions(NodeOptionReader& reader, const Scenario& scenario)
   o.noise_velocity = reader.number("measurement_noise_velocity", 0.0, 0.0, 1000.0);
   o.dropout = reader.number("measurement_dropout", 0.0, 0.0, 1.0);
   if (o.dropout >= 1.0) {
-    throw ParameterError("~measurement_dropout", "must lie in [0, 1), got 1");
+    throw ParameterError("~measurement_dropout",
+                         "must lie in [0, 1), got " + std::to_string(o.dropout));
   }
   o.latency = reader.number("measurement_latency", 0.0, 0.0, 1.0);
+  o.outage_start = reader.number("measurement_outage_start", 0.0, 0.0, 1e7);
+  o.outage_duration = reader.number("measurement_outage_duration", 0.0, 0.0, 1e7);
   o.noise_seed = reader.integer("noise_seed", 1, 0, std::numeric_limits<int>::max());
   o.command_timeout = reader.number("command_timeout", o.command_timeout, 0.0, 3600.0);
   if (o.command_timeout <= 0.0) {
-    throw ParameterError("~command_timeout", "must be > 0, got 0");
+    throw ParameterError("~command_timeout",
+                         "must be > 0, got " + std::to_string(o.command_timeout));
   }
   o.publish_clock = reader.boolean("publish_clock", false);
   o.real_time_factor = reader.number("real_time_factor", 1.0, 0.0, 1000.0);
   if (o.real_time_factor <= 0.0) {
-    throw ParameterError("~real_time_factor", "must lie in (0, 1000], got 0");
+    throw ParameterError("~real_time_factor",
+                         "must lie in (0, 1000], got " + std::to_string(o.real_time_factor));
   }
   o.duration = reader.number("duration", 0.0, 0.0, 1e7);
   return o;
@@ -104,11 +109,12 @@ visualization_msgs::Marker labelMarker(const std::string& frame, const ros::Time
 
 PlantNode::Agent::Agent(const std::string& agent_name, const std::string& tf_frame,
                         const AgentModel& model, double step, const Eigen::VectorXd& initial_state,
-                        const SignalProfile& disturbance)
+                        const SignalProfile& disturbance, double command_timeout)
     : name(agent_name),
       frame(tf_frame),
       integrator(model, step, initial_state, disturbance),
-      command(Eigen::VectorXd::Zero(model.inputDimension())) {}
+      command(Eigen::VectorXd::Zero(model.inputDimension())),
+      command_guard(agent_name + "/command", tf_frame, command_timeout) {}
 
 PlantNode::PlantNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
     : nh_(nh),
@@ -118,20 +124,22 @@ PlantNode::PlantNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
       options_(readOptions(reader_, scenario_)),
       axes_(scenario_.controller.model.double_integrator_axes),
       leader_("leader", options_.leader_frame, scenario_.controller.model, 1.0 / options_.rate,
-              scenario_.leader_initial_state, scenario_.disturbance),
+              scenario_.leader_initial_state, scenario_.disturbance, options_.command_timeout),
       rng_(static_cast<std::mt19937::result_type>(options_.noise_seed)) {
   echoScenario(name_, private_nh);
   reader_.echo(name_);
 
   // The follower list: one follower for now. Subscriptions hold pointers into it, so it is
   // complete before any is made.
-  followers_.push_back(
-      Follower{Agent("follower", options_.follower_frame, scenario_.controller.model,
-                     1.0 / options_.rate, scenario_.follower_initial_state, SignalProfile{}),
-               {},
-               {},
-               0});
+  followers_.push_back(Follower{
+      Agent("follower", options_.follower_frame, scenario_.controller.model, 1.0 / options_.rate,
+            scenario_.follower_initial_state, SignalProfile{}, options_.command_timeout),
+      {},
+      {},
+      0});
   leader_.odom_publisher = nh_.advertise<nav_msgs::Odometry>("leader/odom", 10);
+  leader_.applied_command_publisher =
+      nh_.advertise<geometry_msgs::AccelStamped>("leader/applied_command", 10);
   leader_.command_subscriber = nh_.subscribe<geometry_msgs::AccelStamped>(
       "leader/command", 10,
       [this](const geometry_msgs::AccelStamped::ConstPtr& msg) { onCommand(&leader_, msg); },
@@ -139,6 +147,8 @@ PlantNode::PlantNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   for (Follower& follower : followers_) {
     Agent* agent = &follower.agent;
     agent->odom_publisher = nh_.advertise<nav_msgs::Odometry>(agent->name + "/odom", 10);
+    agent->applied_command_publisher =
+        nh_.advertise<geometry_msgs::AccelStamped>(agent->name + "/applied_command", 10);
     follower.measurement_publisher =
         nh_.advertise<RelativeMeasurement>(agent->name + "/relative_measurement", 10);
     agent->command_subscriber = nh_.subscribe<geometry_msgs::AccelStamped>(
@@ -186,39 +196,23 @@ PlantNode::PlantNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
 
 void PlantNode::onCommand(Agent* agent, const geometry_msgs::AccelStamped::ConstPtr& msg) {
   const std::lock_guard<std::mutex> lock(mutex_);
-  std::string why;
-  Eigen::VectorXd command;
-  bool valid = commandFromAccelMsg(*msg, axes_, &command, &why);
-  std::string kind = why;  // what repeats of one rejection have in common
-  // A command stamped ahead of the plant's time would never time out: its sender's clock is not
-  // the plant's (a wall-time stamp under simulated time, say).
+  // A command stamped ahead of the plant's time by more than ~command_timeout would never time
+  // out: its sender's clock is not the plant's (a wall-time stamp under simulated time, say).
   const ros::Time now = started_ ? stampOf(std::max(0L, next_tick_ - 1)) : ros::Time::now();
-  if (valid && (msg->header.stamp - now).toSec() > options_.command_timeout) {
-    std::ostringstream reason;
-    reason << "stamped " << msg->header.stamp.toSec() << " s, more than ~command_timeout after "
-           << "the plant's time " << now.toSec() << " s (another clock?)";
-    why = reason.str();
-    kind = "stamped in the future";
-    valid = false;
-  }
-  if (!valid) {
-    ++agent->rejected_commands;
-    if (kind != agent->last_rejection) {
-      ROS_WARN_STREAM(name_ << ": " << agent->name << "/command rejected: " << why);
-      agent->last_rejection = kind;
-    } else {
-      ROS_WARN_STREAM_THROTTLE(5.0, name_ << ": " << agent->name << "/command rejected ("
-                                          << agent->rejected_commands << " so far): " << why);
-    }
+  if (!agent->command_guard.checkHeader(msg->header, now)) {
     return;
   }
-  agent->last_rejection.clear();
-  if (!agent->have_command) {
+  std::string why;
+  Eigen::VectorXd command;
+  if (!commandFromAccelMsg(*msg, axes_, &command, &why)) {
+    agent->command_guard.reject(why);
+    return;
+  }
+  if (!agent->command_guard.haveAccepted()) {
     ROS_INFO_STREAM(name_ << ": first " << agent->name << "/command received");
   }
   agent->command = command;
-  agent->command_stamp = msg->header.stamp;
-  agent->have_command = true;
+  agent->command_guard.accept(msg->header.stamp);
 }
 
 ros::Time PlantNode::stampOf(long k) const {
@@ -336,11 +330,17 @@ bool PlantNode::tick(long k) {
   }
 
   // Integrate every agent to t_{k+1} with its command held; the leader under u_d.
-  leader_.integrator.advance(t, commandAt(&leader_, stamp));
+  advanceAgent(&leader_, t, stamp);
   for (Follower& follower : followers_) {
-    follower.agent.integrator.advance(t, commandAt(&follower.agent, stamp));
+    advanceAgent(&follower.agent, t, stamp);
   }
   return true;
+}
+
+void PlantNode::advanceAgent(Agent* agent, double t, const ros::Time& stamp) {
+  const GenericDimensions::InputVector command = commandAt(agent, stamp);
+  agent->applied_command_publisher.publish(toAccelMsg(command, stamp, agent->frame));
+  agent->integrator.advance(t, command);
 }
 
 void PlantNode::publishMeasurement(Follower* follower, long k, const ros::Time& stamp) {
@@ -350,7 +350,22 @@ void PlantNode::publishMeasurement(Follower* follower, long k, const ros::Time& 
     noise(i) = normal_(rng_) * (i < axes_ ? options_.noise_position : options_.noise_velocity);
   }
   const bool dropped = uniform_(rng_) < options_.dropout;
-  if (dropped) {
+  const double t = static_cast<double>(k) / options_.rate;
+  const bool in_outage = options_.outage_duration > 0.0 && t >= options_.outage_start &&
+                         t < options_.outage_start + options_.outage_duration;
+  if (in_outage) {
+    if (!follower->in_outage) {
+      ROS_WARN_STREAM(name_ << ": " << follower->agent.name << "/relative_measurement outage for "
+                            << options_.outage_duration << " s from t = " << t << " s");
+    }
+  } else if (follower->in_outage) {
+    ROS_INFO_STREAM(name_ << ": " << follower->agent.name
+                          << "/relative_measurement outage over at t = " << t << " s");
+  }
+  follower->in_outage = in_outage;
+  if (in_outage) {
+    // Nothing sampled; what was sampled before still arrives after its latency.
+  } else if (dropped) {
     ++follower->dropped;
   } else {
     const Eigen::VectorXd relative =
@@ -388,8 +403,9 @@ void PlantNode::publishMarkers(const ros::Time& stamp) {
 }
 
 GenericDimensions::InputVector PlantNode::commandAt(Agent* agent, const ros::Time& now) {
-  const bool fresh = agent->have_command &&
-                     std::abs((now - agent->command_stamp).toSec()) <= options_.command_timeout;
+  const InputGuard& guard = agent->command_guard;
+  const bool fresh = guard.haveAccepted() &&
+                     std::abs((now - guard.lastStamp()).toSec()) <= options_.command_timeout;
   if (fresh) {
     if (agent->command_timed_out) {
       ROS_INFO_STREAM(name_ << ": " << agent->name << "/command fresh again");
@@ -397,11 +413,10 @@ GenericDimensions::InputVector PlantNode::commandAt(Agent* agent, const ros::Tim
     }
     return agent->command;
   }
-  if (agent->have_command && !agent->command_timed_out) {
-    ROS_WARN_STREAM(name_ << ": " << agent->name << "/command stamped "
-                          << agent->command_stamp.toSec() << " s is older than ~command_timeout ("
-                          << options_.command_timeout << " s) at " << now.toSec()
-                          << " s: using zero");
+  if (guard.haveAccepted() && !agent->command_timed_out) {
+    ROS_WARN_STREAM(name_ << ": " << agent->name << "/command stamped " << guard.lastStamp().toSec()
+                          << " s is older than ~command_timeout (" << options_.command_timeout
+                          << " s) at " << now.toSec() << " s: using zero");
     agent->command_timed_out = true;
   }
   return GenericDimensions::InputVector::Zero(axes_);

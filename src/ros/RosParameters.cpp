@@ -32,14 +32,20 @@ std::string typeName(const XmlRpc::XmlRpcValue& value) {
       return "a list";
     case XmlRpc::XmlRpcValue::TypeStruct:
       return "a map";
+    case XmlRpc::XmlRpcValue::TypeBase64:
+      return "binary data";
+    case XmlRpc::XmlRpcValue::TypeDateTime:
+      return "a date";
     default:
       return "of another type";
   }
 }
 
-}  // namespace
-
-YAML::Node toYaml(const XmlRpc::XmlRpcValue& value) {
+/// toYaml() below @p path (a dotted path, "" for the root). A string becomes a scalar tagged as
+/// a string, so that "0.2" or "true" is not taken for a number or a boolean; binary data and
+/// dates have no place in a scenario and are refused with their path.
+// NOLINTNEXTLINE(misc-no-recursion): bounded by the depth of the parameter tree
+YAML::Node toYamlAt(const XmlRpc::XmlRpcValue& value, const std::string& path) {
   XmlRpc::XmlRpcValue& v = const_cast<XmlRpc::XmlRpcValue&>(value);  // XmlRpc lacks const access
   switch (v.getType()) {
     case XmlRpc::XmlRpcValue::TypeBoolean:
@@ -48,26 +54,34 @@ YAML::Node toYaml(const XmlRpc::XmlRpcValue& value) {
       return YAML::Node(static_cast<int>(v));
     case XmlRpc::XmlRpcValue::TypeDouble:
       return YAML::Node(static_cast<double>(v));
-    case XmlRpc::XmlRpcValue::TypeString:
-      return YAML::Node(static_cast<std::string>(v));
+    case XmlRpc::XmlRpcValue::TypeString: {
+      YAML::Node text(static_cast<std::string>(v));
+      text.SetTag("!");  // as YAML tags a quoted scalar
+      return text;
+    }
     case XmlRpc::XmlRpcValue::TypeArray: {
       YAML::Node sequence(YAML::NodeType::Sequence);
       for (int i = 0; i < v.size(); ++i) {
-        sequence.push_back(toYaml(v[i]));
+        sequence.push_back(toYamlAt(v[i], (path.empty() ? "" : path + ".") + std::to_string(i)));
       }
       return sequence;
     }
     case XmlRpc::XmlRpcValue::TypeStruct: {
       YAML::Node map(YAML::NodeType::Map);
       for (auto& entry : v) {
-        map[entry.first] = toYaml(entry.second);
+        map[entry.first] = toYamlAt(entry.second, (path.empty() ? "" : path + ".") + entry.first);
       }
       return map;
     }
     default:
-      return YAML::Node(YAML::NodeType::Null);
+      throw ParameterError(
+          path, "must be a number, a string, a boolean, a list or a map, got " + typeName(value));
   }
 }
+
+}  // namespace
+
+YAML::Node toYaml(const XmlRpc::XmlRpcValue& value) { return toYamlAt(value, ""); }
 
 Scenario loadScenarioParameter(const ros::NodeHandle& private_nh, const std::string& name) {
   XmlRpc::XmlRpcValue value;
@@ -97,6 +111,13 @@ Scenario loadDoubleIntegratorScenario(const ros::NodeHandle& private_nh, const s
                          "the ROS nodes run double_integrator models (relative position and "
                          "velocity); use cf_sim for a linear model");
   }
+  const double rate = scenario.controller.control_rate;
+  if (!(rate >= kMinNodeRate && rate <= kMaxNodeRate)) {
+    std::ostringstream reason;
+    reason << "the ROS nodes run at " << kMinNodeRate << " to " << kMaxNodeRate << " Hz, got "
+           << rate << "; use cf_sim for other rates";
+    throw ParameterError("~" + name + "/controller/control_rate", reason.str());
+  }
   return scenario;
 }
 
@@ -123,7 +144,8 @@ double NodeOptionReader::number(const std::string& key, double fallback, double 
   }
   if (!(result >= min && result <= max)) {  // also refuses NaN
     std::ostringstream reason;
-    reason << "must lie in [" << min << ", " << max << "], got " << result;
+    reason << "must lie in [" << min << ", " << max << "], got " << result
+           << (present ? "" : " (its default): set it");
     throw ParameterError("~" + key, reason.str());
   }
   std::ostringstream text;
@@ -144,7 +166,8 @@ int NodeOptionReader::integer(const std::string& key, int fallback, int min, int
   }
   if (result < min || result > max) {
     throw ParameterError("~" + key, "must lie in [" + std::to_string(min) + ", " +
-                                        std::to_string(max) + "], got " + std::to_string(result));
+                                        std::to_string(max) + "], got " + std::to_string(result) +
+                                        (present ? "" : " (its default): set it"));
   }
   remember(key, std::to_string(result), !present);
   return result;

@@ -1,7 +1,9 @@
 #include "projection_collision_avoidance/ScenarioLoader.hpp"
 
+#include <cmath>
 #include <cstddef>
 #include <exception>
+#include <filesystem>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -108,6 +110,19 @@ AgentModel readModel(detail::YamlReader& reader) {
   return result;
 }
 
+/// natural_frequency or damping: one value per axis (or one number for all), each positive.
+void requirePositivePerAxis(const std::string& key, const Eigen::VectorXd& values, int axes) {
+  if (values.size() != axes) {
+    throw ParameterError(key, "must be one number or one per axis (" + std::to_string(axes) +
+                                  "), got " + std::to_string(values.size()));
+  }
+  for (Eigen::Index i = 0; i < values.size(); ++i) {
+    if (!(std::isfinite(values(i)) && values(i) > 0.0)) {
+      throw ParameterError(key, "must be positive and finite, got " + std::to_string(values(i)));
+    }
+  }
+}
+
 Eigen::MatrixXd readGain(detail::YamlReader& section, const AgentModel& model) {
   const bool matrix_form = section.has("gain");
   const bool pole_form = section.has("natural_frequency") || section.has("damping");
@@ -125,6 +140,8 @@ Eigen::MatrixXd readGain(detail::YamlReader& section, const AgentModel& model) {
   const int axes = model.double_integrator_axes;
   const Eigen::VectorXd omega = section.vectorOrScalar("natural_frequency", axes);
   const Eigen::VectorXd zeta = section.vectorOrScalar("damping", axes);
+  requirePositivePerAxis(section.key("natural_frequency"), omega, axes);
+  requirePositivePerAxis(section.key("damping"), zeta, axes);
   return doubleIntegratorGain(omega, zeta, section.key("natural_frequency"));
 }
 
@@ -204,7 +221,10 @@ ControllerParameters readController(detail::YamlReader& reader, const AgentModel
   return result;
 }
 
-std::vector<Pulse> readPulses(detail::YamlReader& parent, const std::string& name) {
+/// The pulses of the list @p name; each is checked against @p size entries, so that an error
+/// names the entry by its path in the file ("leader.disturbance.0.vector").
+std::vector<Pulse> readPulses(detail::YamlReader& parent, const std::string& name,
+                              Eigen::Index size) {
   std::vector<Pulse> pulses;
   const std::size_t count = parent.sequenceSize(name);
   for (std::size_t i = 0; i < count; ++i) {
@@ -214,19 +234,36 @@ std::vector<Pulse> readPulses(detail::YamlReader& parent, const std::string& nam
     pulse.end = item.number("end");
     pulse.vector = item.vector("vector");
     item.finish();
+    if (!std::isfinite(pulse.start)) {
+      throw ParameterError(item.key("start"), "must be finite");
+    }
+    if (!std::isfinite(pulse.end)) {
+      throw ParameterError(item.key("end"), "must be finite");
+    }
+    if (!(pulse.start < pulse.end)) {
+      throw ParameterError(item.key("end"), "must be later than start");
+    }
+    if (pulse.vector.size() != size) {
+      throw ParameterError(item.key("vector"), "must have " + std::to_string(size) +
+                                                   " entries, got " +
+                                                   std::to_string(pulse.vector.size()));
+    }
+    if (!pulse.vector.allFinite()) {
+      throw ParameterError(item.key("vector"), "has a non-finite entry");
+    }
     pulses.push_back(pulse);
   }
   return pulses;
 }
 
-SignalProfile readInputProfile(detail::YamlReader& leader) {
+SignalProfile readInputProfile(detail::YamlReader& leader, Eigen::Index size) {
   SignalProfile profile;
   if (!leader.has("input")) {
     return profile;
   }
   detail::YamlReader input = leader.map("input");
   if (input.has("pulses")) {
-    profile.pulses = readPulses(input, "pulses");
+    profile.pulses = readPulses(input, "pulses", size);
   }
   if (input.has("sinusoids")) {
     const std::size_t count = input.sequenceSize("sinusoids");
@@ -252,9 +289,9 @@ Scenario readScenario(const YAML::Node& root) {
 
   detail::YamlReader leader = reader.map("leader");
   scenario.leader_initial_state = leader.vector("initial_state");
-  scenario.leader_input = readInputProfile(leader);
+  scenario.leader_input = readInputProfile(leader, model.inputDimension());
   if (leader.has("disturbance")) {
-    scenario.disturbance.pulses = readPulses(leader, "disturbance");
+    scenario.disturbance.pulses = readPulses(leader, "disturbance", model.stateDimension());
   }
   leader.finish();
 
@@ -276,10 +313,14 @@ Scenario parseRoot(YAML::Node root, const std::vector<std::string>& overrides) {
   if (!root.IsMap()) {
     throw ParameterError("(root)", "a scenario is a YAML map");
   }
-  for (const std::string& assignment : overrides) {
-    applyOverride(root, assignment);
+  try {
+    for (const std::string& assignment : overrides) {
+      applyOverride(root, assignment);
+    }
+    return readScenario(root);
+  } catch (const YAML::Exception& error) {  // every read names its key; this is a safety net
+    throw ParameterError("(root)", std::string("cannot be read: ") + error.what());
   }
-  return readScenario(root);
 }
 
 }  // namespace
@@ -299,6 +340,10 @@ Scenario parseScenario(const std::string& yaml_text, const std::vector<std::stri
 }
 
 Scenario loadScenarioFile(const std::string& path, const std::vector<std::string>& overrides) {
+  std::error_code ignored;
+  if (std::filesystem::is_directory(path, ignored)) {
+    throw ParameterError("(file)", "'" + path + "' is a directory, not a scenario file");
+  }
   std::ifstream file(path);
   if (!file) {
     throw ParameterError("(file)", "cannot read '" + path + "'");

@@ -4,9 +4,12 @@
 /// Typed, key-tracking access to one YAML map of a scenario (internal to the scenario library).
 /// Every read marks its key as known; finish() refuses the keys nobody read.
 
+#include <cmath>
 #include <cstddef>
+#include <limits>
 #include <set>
 #include <string>
+#include <type_traits>
 #include <utility>
 
 #include <Eigen/Core>
@@ -49,10 +52,18 @@ class YamlReader {
   double number(const std::string& name) { return scalar<double>(name, "a number"); }
   bool boolean(const std::string& name) { return scalar<bool>(name, "true or false"); }
 
+  /// A whole number that fits an int (a YAML integer, or a real with no fractional part).
   int integer(const std::string& name) {
     const double value = number(name);
-    if (value != static_cast<double>(static_cast<int>(value))) {
-      throw ParameterError(key(name), "must be a whole number");
+    const YAML::Node& node = node_;
+    const std::string text = "'" + node[name].Scalar() + "'";
+    if (!(std::abs(value) <= static_cast<double>(std::numeric_limits<int>::max()))) {
+      throw ParameterError(key(name), "must be a whole number within +-" +
+                                          std::to_string(std::numeric_limits<int>::max()) +
+                                          ", got " + text);
+    }
+    if (value != std::trunc(value)) {
+      throw ParameterError(key(name), "must be a whole number, got " + text);
     }
     return static_cast<int>(value);
   }
@@ -132,7 +143,11 @@ class YamlReader {
   /// Refuses every key of this map that was not read.
   void finish() const {
     for (const auto& entry : node_) {
-      const auto name = entry.first.as<std::string>();
+      if (!entry.first.IsScalar()) {
+        throw ParameterError(path_.empty() ? "(root)" : path_,
+                             "has a key that is not a name (a list or a map)");
+      }
+      const std::string& name = entry.first.Scalar();
       if (used_.count(name) == 0) {
         throw ParameterError(key(name), "unknown key");
       }
@@ -150,11 +165,21 @@ class YamlReader {
     return child;
   }
 
+  /// True for a scalar that YAML types as a string: quoted ("0.2", '1') or tagged !!str, and
+  /// every string parameter converted from ROS (see toYaml()).
+  static bool isString(const YAML::Node& node) {
+    return node.IsScalar() && (node.Tag() == "!" || node.Tag() == "tag:yaml.org,2002:str");
+  }
+
   template <typename T>
   T scalar(const std::string& name, const char* what) {
     const YAML::Node child = required(name);
     if (!child.IsScalar()) {
       throw ParameterError(key(name), std::string("must be ") + what);
+    }
+    if (!std::is_same<T, std::string>::value && isString(child)) {
+      throw ParameterError(
+          key(name), std::string("must be ") + what + ", got the string '" + child.Scalar() + "'");
     }
     try {
       return child.as<T>();
@@ -165,6 +190,9 @@ class YamlReader {
   }
 
   static double toNumber(const YAML::Node& node, const std::string& key) {
+    if (isString(node)) {
+      throw ParameterError(key, "must be a number, got the string '" + node.Scalar() + "'");
+    }
     try {
       return node.as<double>();
     } catch (const YAML::Exception&) {

@@ -165,8 +165,13 @@ TEST(ScenarioLoader, RefusesWrongSizesAndValues) {
   expectKey({"controller.baseline={gain: 1}"}, "controller.baseline.gain", "square");
   expectKey({"leader.initial_state=[5]"}, "leader.initial_state", "2 entries");
   expectKey({"follower.initial_state=[0, .nan]"}, "follower.initial_state", "non-finite");
-  expectKey({"leader.disturbance.0.vector=[1]"}, "leader.disturbance.pulses.0.vector", "2 entries");
-  expectKey({"leader.disturbance.0.end=10"}, "leader.disturbance.pulses.0.end", "later");
+  // Pulses are named by their path in the file (the disturbance is a list of pulses).
+  expectKey({"leader.disturbance.0.vector=[1]"}, "leader.disturbance.0.vector", "2 entries");
+  expectKey({"leader.disturbance.0.vector=[.nan, 0]"}, "leader.disturbance.0.vector", "non-finite");
+  expectKey({"leader.disturbance.0.end=10"}, "leader.disturbance.0.end", "later");
+  expectKey({"leader.disturbance.0.start=.inf"}, "leader.disturbance.0.start", "finite");
+  expectKey({"leader.input={pulses: [{start: 0, end: 1, vector: [1, 2]}]}"},
+            "leader.input.pulses.0.vector", "1 entries");
   expectKey({"simulation.duration=0"}, "simulation.duration", "positive");
   expectKey({"model.dimension=4"}, "model.dimension", "1, 2 or 3");
   expectKey({"controller.alpha=1.5"}, "controller.alpha", "[0, 1)");
@@ -179,12 +184,91 @@ TEST(ScenarioLoader, RefusesWrongSizesAndValues) {
             "controller.estimator.lyapunov_weight", "positive definite");
 }
 
+TEST(ScenarioLoader, RefusesStringsForNumbersAndBooleans) {
+  // Quoted (or !!str) scalars are strings in YAML, as are string ROS parameters.
+  expectKey({"controller.alpha='0.2'"}, "controller.alpha", "got the string '0.2'");
+  expectKey({"controller.control_rate=\"100\""}, "controller.control_rate", "string");
+  expectKey({"controller.alpha=!!str 0.2"}, "controller.alpha", "string");
+  expectKey({"controller.tracker.enabled='true'"}, "controller.tracker.enabled", "string");
+  expectKey({"controller.estimator.substeps='2'"}, "controller.estimator.substeps", "string");
+  expectKey({"controller.separation=[5, '0']"}, "controller.separation", "string");
+  expectKey({"controller.tracker.gain=[[10, '5']]"}, "controller.tracker.gain.0", "string");
+  expectKey({"controller.estimator.gain='-5'"}, "controller.estimator.gain", "string");
+  // The same scalars unquoted are numbers and booleans; strings stay strings.
+  const Scenario s =
+      parseScenario(paperText(), {"controller.alpha=0.25", "model.type='double_integrator'",
+                                  "controller.estimator.initial_estimate='zero'"});
+  EXPECT_DOUBLE_EQ(s.controller.alpha, 0.25);
+  EXPECT_EQ(s.controller.initial_estimate, InitialEstimate::kZero);
+}
+
+TEST(ScenarioLoader, AcceptsWholeNumbersWhereRealsAreExpected) {
+  const Scenario s = parseScenario(
+      paperText(), {"controller.alpha=0", "controller.control_rate=100", "controller.epsilon=1",
+                    "controller.separation=[5, 0]", "controller.baseline={gain: [[1, 2]]}",
+                    "controller.acceleration_limit=50", "simulation.duration=60",
+                    "leader.disturbance=[{start: 20, end: 23, vector: [-2, -2]}]"});
+  EXPECT_DOUBLE_EQ(s.controller.alpha, 0.0);
+  EXPECT_DOUBLE_EQ(s.controller.control_rate, 100.0);
+  EXPECT_DOUBLE_EQ(s.controller.epsilon, 1.0);
+  EXPECT_DOUBLE_EQ(s.controller.acceleration_limit, 50.0);
+  EXPECT_DOUBLE_EQ(s.disturbance.pulses[0].start, 20.0);
+}
+
+TEST(ScenarioLoader, RefusesWholeNumbersOutOfRange) {
+  expectKey({"controller.estimator.substeps=1e12"}, "controller.estimator.substeps", "within");
+  expectKey({"controller.estimator.substeps=-1e12"}, "controller.estimator.substeps", "within");
+  expectKey({"controller.estimator.substeps=.nan"}, "controller.estimator.substeps", "whole");
+  expectKey({"controller.estimator.substeps=.inf"}, "controller.estimator.substeps", "whole");
+  expectKey({"controller.estimator.substeps=2000000000"}, "controller.estimator.substeps",
+            "between 1 and 1000");
+  expectKey({"model.dimension=1e10"}, "model.dimension", "whole");
+  expectKey({"model.dimension=1.5"}, "model.dimension", "whole number, got '1.5'");
+}
+
+TEST(ScenarioLoader, NamesNaturalFrequencyAndDampingSeparately) {
+  expectKey({"controller.baseline.damping=0"}, "controller.baseline.damping", "positive");
+  expectKey({"controller.baseline.damping=.nan"}, "controller.baseline.damping", "finite");
+  expectKey({"controller.baseline.natural_frequency=-1"}, "controller.baseline.natural_frequency",
+            "positive");
+  expectKey({"controller.baseline.damping=[0.7, 0.7]"}, "controller.baseline.damping",
+            "one per axis (1), got 2");
+  expectKey({"controller.baseline.natural_frequency=[1, 1]"},
+            "controller.baseline.natural_frequency", "one per axis");
+  expectKey({"controller.tracker={enabled: true, natural_frequency: 2, damping: -1}"},
+            "controller.tracker.damping", "positive");
+}
+
+TEST(ScenarioLoader, RefusesKeysThatAreNotNames) {
+  std::string text = paperText();
+  text.replace(text.find("controller:\n"), 12, "controller:\n  [1, 2]: 3\n");
+  try {
+    parseScenario(text);
+    ADD_FAILURE() << "accepted a list as a key";
+  } catch (const ParameterError& error) {
+    EXPECT_EQ(error.key(), "controller") << error.what();
+  }
+  try {
+    parseScenario(paperText() + "[1]: 2\n");
+    ADD_FAILURE() << "accepted a list as a key";
+  } catch (const ParameterError& error) {
+    EXPECT_EQ(error.key(), "(root)") << error.what();
+  }
+}
+
 TEST(ScenarioLoader, RefusesBadOverridesAndFiles) {
   expectKey({"controller.alpha"}, "controller.alpha", "key=value");
   expectKey({"leader.disturbance.5.start=1"}, "leader.disturbance.5.start", "past the end");
   expectKey({"controller.alpha.value=1"}, "controller.alpha.value", "not a map");
   expectKey({"controller..alpha=1"}, "controller..alpha", "empty");
   EXPECT_THROW(loadScenarioFile("/nonexistent/scenario.yaml"), ParameterError);
+  try {
+    loadScenarioFile(SCENARIO_DIR);
+    ADD_FAILURE() << "accepted a directory";
+  } catch (const ParameterError& error) {
+    EXPECT_EQ(error.key(), "(file)");
+    EXPECT_NE(std::string(error.what()).find("directory"), std::string::npos) << error.what();
+  }
   EXPECT_THROW(parseScenario("model: [unclosed"), ParameterError);
   EXPECT_THROW(parseScenario("- a\n- b\n"), ParameterError);
 }

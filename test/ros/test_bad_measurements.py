@@ -1,7 +1,7 @@
 #!/usr/bin/python3
-"""rostest: hand-written measurements, as a vehicle stack would send them, to a lone follower:
-each malformed one is rejected and counted in the status, and the command stays finite.
-Parameters: ~wall_deadline (s) for each condition."""
+"""rostest: hand-written measurements and leader broadcasts, as a vehicle stack would send them,
+to a lone follower: each malformed one is rejected and counted in the status, the command stays
+finite and the follower keeps tracking. Parameters: ~wall_deadline (s) for each condition."""
 
 import math
 import sys
@@ -11,7 +11,8 @@ import unittest
 import rospy
 import rostest
 from geometry_msgs.msg import AccelStamped
-from projection_collision_avoidance.msg import FollowerStatus, RelativeMeasurement
+from projection_collision_avoidance.msg import (FollowerStatus, LeaderBroadcast,
+                                                RelativeMeasurement)
 
 PACKAGE = "projection_collision_avoidance"
 
@@ -24,6 +25,8 @@ class BadMeasurements(unittest.TestCase):
         rospy.Subscriber("/command", AccelStamped, self.on_command)
         self.publisher = rospy.Publisher("/relative_measurement", RelativeMeasurement,
                                          queue_size=10)
+        self.leader_publisher = rospy.Publisher("/leader_broadcast", LeaderBroadcast,
+                                                queue_size=10)
         self.deadline = rospy.get_param("~wall_deadline")
 
     def on_status(self, msg):
@@ -48,8 +51,22 @@ class BadMeasurements(unittest.TestCase):
         msg.velocity = velocity
         self.publisher.publish(msg)
 
+    def send_broadcast(self, frame="world", stamp_offset=0.0, position=(0.0,), velocity=(0.0,),
+                       leader_input=(0.0,), disturbance=()):
+        msg = LeaderBroadcast()
+        msg.header.stamp = rospy.Time.now() + rospy.Duration(stamp_offset)
+        msg.header.frame_id = frame
+        msg.position = list(position)
+        msg.velocity = list(velocity)
+        msg.input = list(leader_input)
+        msg.disturbance = list(disturbance)
+        self.leader_publisher.publish(msg)
+
     def rejected(self):
         return self.status.rejected_measurements if self.status else -1
+
+    def rejected_broadcasts(self):
+        return self.status.rejected_leader_broadcasts if self.status else -1
 
     def test_malformed_measurements_are_rejected_and_counted(self):
         self.assertTrue(self.wait_for(lambda: self.publisher.get_num_connections() > 0))
@@ -75,6 +92,35 @@ class BadMeasurements(unittest.TestCase):
         # A good measurement after all that is taken again.
         self.send([5.0], [0.0])
         self.assertTrue(self.wait_for(lambda: self.status.measurement_fresh))
+        self.assertEqual(self.status.mode, FollowerStatus.MODE_TRACKING)
+
+    def test_malformed_leader_broadcasts_are_rejected_and_counted(self):
+        self.assertTrue(self.wait_for(lambda: self.publisher.get_num_connections() > 0))
+        self.assertTrue(self.wait_for(lambda: self.leader_publisher.get_num_connections() > 0))
+        self.send([5.0], [0.0])
+        self.assertTrue(self.wait_for(lambda: self.status is not None), "no status")
+        self.send_broadcast()
+        self.assertTrue(self.wait_for(lambda: self.status.leader_fresh), "broadcast not taken")
+        self.assertEqual(self.rejected_broadcasts(), 0)
+        cases = [
+            ("non-finite input", dict(leader_input=[math.nan])),
+            ("infinite position", dict(position=[math.inf])),
+            ("wrong input size", dict(leader_input=[0.0, 0.0])),
+            ("empty velocity", dict(velocity=[])),
+            ("wrong disturbance size", dict(disturbance=[0.0])),
+            ("non-finite disturbance", dict(disturbance=[0.0, math.nan])),
+            ("wrong frame", dict(frame="map")),
+            ("future stamp", dict(stamp_offset=10.0)),
+            ("older than the last", dict(stamp_offset=-10.0)),
+        ]
+        for count, (name, fields) in enumerate(cases, start=1):
+            self.send([5.0], [0.0])  # keep the measurement fresh
+            self.send_broadcast(**fields)
+            self.assertTrue(self.wait_for(lambda c=count: self.rejected_broadcasts() == c),
+                            f"{name}: rejected count {self.rejected_broadcasts()}, "
+                            f"expected {count}")
+        self.assertTrue(all(math.isfinite(u) for u in self.commands))
+        self.assertEqual(self.rejected(), 0)
 
 
 if __name__ == "__main__":

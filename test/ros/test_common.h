@@ -4,9 +4,11 @@
 /// Fixture of the rostests: subscribes to what the follower publishes, and waits on conditions
 /// with wall-clock deadlines (never fixed sleeps).
 
+#include <cmath>
 #include <functional>
 #include <limits>
 #include <mutex>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -26,7 +28,11 @@ struct StatusRecord {
   double max_xi = 0.0;
   double max_xi_hat = 0.0;
   double min_separation = std::numeric_limits<double>::infinity();
-  double last_time = 0.0;  ///< stamp of the latest status (s)
+  double max_command = 0.0;     ///< largest ||command|| (m/s^2)
+  bool commands_finite = true;  ///< every command entry finite so far
+  int fallback_ticks = 0;       ///< statuses with fallback set
+  std::set<int> modes;          ///< FollowerStatus::mode values seen
+  double last_time = 0.0;       ///< stamp of the latest status (s)
   FollowerStatus last;
 };
 
@@ -88,6 +94,14 @@ class FollowerTest : public ::testing::Test {
     record_.max_xi = std::max(record_.max_xi, msg->xi_norm);
     record_.max_xi_hat = std::max(record_.max_xi_hat, msg->xi_hat_norm);
     record_.min_separation = std::min(record_.min_separation, msg->separation);
+    double squared = 0.0;
+    for (const double u : msg->command) {
+      record_.commands_finite = record_.commands_finite && std::isfinite(u);
+      squared += u * u;
+    }
+    record_.max_command = std::max(record_.max_command, std::sqrt(squared));
+    record_.fallback_ticks += msg->fallback ? 1 : 0;
+    record_.modes.insert(msg->mode);
     record_.last_time = msg->header.stamp.toSec();
     record_.last = *msg;
   }

@@ -53,6 +53,11 @@ TEST_F(FollowerTest, PublishesStatusWithTheScenariosBounds) {
   const FollowerStatus s = record().last;
   EXPECT_EQ(s.header.frame_id, "follower");
   EXPECT_TRUE(s.measurement_fresh);
+  EXPECT_EQ(s.mode, FollowerStatus::MODE_TRACKING);
+  EXPECT_EQ(s.mode_name, "tracking");
+  EXPECT_FALSE(s.fallback);
+  EXPECT_TRUE(std::isinf(s.acceleration_limit));  // none in the paper's scenario
+  EXPECT_EQ(s.fallback_command.size(), 1u);
   EXPECT_EQ(s.xi.size(), 2u);
   EXPECT_EQ(s.xi_hat.size(), 2u);
   EXPECT_EQ(s.command.size(), 1u);
@@ -122,6 +127,8 @@ TEST_F(FollowerTest, PublishesDiagnostics) {
   EXPECT_EQ(keys.count("xi_norm (m)"), 1u);
   EXPECT_EQ(keys.count("margin (m)"), 1u);
   EXPECT_EQ(keys.count("rejected_measurements"), 1u);
+  EXPECT_EQ(keys.count("rejected_leader_broadcasts"), 1u);
+  EXPECT_EQ(keys.count("mode"), 1u);
 }
 
 TEST_F(FollowerTest, ReconfigureSwitchesTheTrackerAndRefusesAnInvalidAlpha) {

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <memory>
 #include <mutex>
 #include <string>
 
@@ -7,50 +8,61 @@
 #include <boost/thread/recursive_mutex.hpp>
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <dynamic_reconfigure/server.h>
+#include <ros/callback_queue.h>
 #include <ros/ros.h>
 
 #include "projection_collision_avoidance/FollowerConfig.h"
+#include "projection_collision_avoidance/FollowerMode.hpp"
 #include "projection_collision_avoidance/LeaderBroadcast.h"
 #include "projection_collision_avoidance/RelativeMeasurement.h"
 #include "projection_collision_avoidance/RuntimeFollowerController.hpp"
 #include "projection_collision_avoidance/Scenario.hpp"
+#include "projection_collision_avoidance/ros/InputGuard.hpp"
 
 namespace projection_collision_avoidance {
 
 /// The follower node's own options (besides the scenario), read once from its private namespace.
 struct FollowerNodeOptions {
-  double measurement_timeout = 0.5;   ///< s; older measurements are reported stale
-  double leader_timeout = 0.5;        ///< s; older leader broadcasts are not used
-  double max_future_stamp = 0.1;      ///< s; measurements stamped after now + this are refused
-  bool use_leader_broadcast = false;  ///< subscribe to leader_broadcast for u_1
-  std::string measurement_frame;      ///< required frame_id of measurements ("" = any)
+  double measurement_timeout = 0.5;    ///< s; an older measurement puts the follower in fallback
+  double leader_timeout = 0.5;         ///< s; an older leader broadcast is not used
+  double max_future_stamp = 0.1;       ///< s; inputs stamped after now + this are refused
+  bool use_leader_broadcast = false;   ///< use u_1 from leader_broadcast (always monitored)
+  std::string measurement_frame;       ///< required frame_id of measurements ("" = any)
+  std::string leader_broadcast_frame;  ///< required frame_id of leader broadcasts ("" = any)
   std::string follower_frame = "follower";  ///< frame of the command, status and markers
   double marker_rate = 10.0;                ///< Hz
 };
 
 /// ROS wrapper of RuntimeFollowerController: translates messages and time, nothing else.
 ///
-/// Subscribes `relative_measurement` (RelativeMeasurement, x_1 - x_2) and, optionally,
-/// `leader_broadcast` (LeaderBroadcast, for u_1). Every 1 / control_rate s (ROS time) it runs the
-/// controller on y = C (x_1 - x_2 - d) and publishes `command` (geometry_msgs/AccelStamped),
-/// `status` (FollowerStatus), `markers` (visualization_msgs/MarkerArray, in the follower's
-/// frame) and diagnostics. dynamic_reconfigure changes the tracker switch, alpha, epsilon and the
-/// tracker gain; a set the controller design refuses is rejected and the old one kept.
+/// Subscribes `relative_measurement` (RelativeMeasurement, x_1 - x_2) and `leader_broadcast`
+/// (LeaderBroadcast: monitored always, its u_1 used with ~use_leader_broadcast). Every
+/// 1 / control_rate s (ROS time) it picks the mode from the inputs' ages (selectFollowerMode()):
+/// with a fresh measurement it runs the controller on y = C (x_1 - x_2 - d), with a stale one the
+/// braking fallback; then it publishes `command` (geometry_msgs/AccelStamped), `status`
+/// (FollowerStatus), `markers` (visualization_msgs/MarkerArray, in the follower's frame) and
+/// diagnostics. Messages that are non-finite, of the wrong size, in the wrong frame, stamped in
+/// the future or before the last accepted one are refused and counted. dynamic_reconfigure
+/// changes the tracker switch, alpha, epsilon and the tracker gain; a set the controller design
+/// refuses is rejected and the old one kept.
 class FollowerNode {
  public:
   /// @throws ParameterError naming the parameter when the scenario or an option is invalid
   FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh);
+  ~FollowerNode();
+  FollowerNode(const FollowerNode&) = delete;
+  FollowerNode& operator=(const FollowerNode&) = delete;
 
  private:
   void onMeasurement(const RelativeMeasurement::ConstPtr& msg);
   void onLeaderBroadcast(const LeaderBroadcast::ConstPtr& msg);
   void onControlTick(const ros::TimerEvent& event);
   void onReconfigure(FollowerConfig& config, uint32_t level);
-  void publishStatus(const ros::Time& now, const Eigen::VectorXd& xi, bool fresh);
+  void publishStatus(const ros::Time& now, const Eigen::VectorXd& xi, double measurement_age);
   void publishMarkers(const ros::Time& now, const Eigen::VectorXd& xi);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
   FollowerConfig configOf(const ControllerParameters& parameters) const;
-  void rejectMeasurement(const std::string& why);
+  void logModeChange(FollowerMode mode);
 
   ros::NodeHandle nh_;
   ros::NodeHandle private_nh_;
@@ -61,14 +73,11 @@ class FollowerNode {
 
   std::mutex mutex_;  ///< guards everything below against concurrent callbacks (nodelets)
   Eigen::VectorXd relative_state_;  ///< latest accepted x_1 - x_2
-  ros::Time measurement_stamp_;
-  bool have_measurement_ = false;
-  Eigen::VectorXd leader_input_;
-  ros::Time leader_stamp_;
-  bool have_leader_input_ = false;
-  unsigned rejected_measurements_ = 0;
-  std::string last_rejection_;
-  bool last_tick_fresh_ = false;
+  InputGuard measurement_guard_;
+  Eigen::VectorXd leader_input_;  ///< u_1 of the latest accepted leader broadcast
+  InputGuard leader_guard_;
+  FollowerMode mode_ = FollowerMode::kWaiting;  ///< of the latest tick
+  bool leader_fresh_ = false;                   ///< at the latest tick
   double last_xi_norm_ = 0.0;
   long ticks_ = 0;
 
@@ -78,6 +87,10 @@ class FollowerNode {
   ros::Publisher status_publisher_;
   ros::Publisher marker_publisher_;
   ros::Timer timer_;
+  /// The control timer has a queue and a thread of its own, so that a flood of input messages
+  /// on the node's other queue cannot delay a tick (beyond the brief hold of mutex_).
+  ros::CallbackQueue control_queue_;
+  std::unique_ptr<ros::AsyncSpinner> control_spinner_;
   diagnostic_updater::Updater diagnostics_;
   FollowerConfig applied_config_;  ///< the reconfigure values in force
   boost::recursive_mutex reconfigure_mutex_;

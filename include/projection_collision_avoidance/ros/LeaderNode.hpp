@@ -8,6 +8,7 @@
 #include <ros/ros.h>
 
 #include "projection_collision_avoidance/Scenario.hpp"
+#include "projection_collision_avoidance/ros/InputGuard.hpp"
 
 namespace projection_collision_avoidance {
 
@@ -44,7 +45,9 @@ class LeaderNode {
   nav_msgs::Odometry odometry_;  ///< latest accepted
   Eigen::VectorXd state_;        ///< its [p; v]
   bool have_odometry_ = false;
-  unsigned rejected_odometry_ = 0;
+  /// s by which an odometry stamp may lie ahead of the leader's clock
+  static constexpr double kMaxFutureStamp = 0.1;
+  InputGuard odometry_guard_{"leader/odom", "", kMaxFutureStamp};
   bool started_ = false;
   ros::Time origin_;      ///< ROS time of scenario time 0
   ros::Time last_stamp_;  ///< of the last tick published

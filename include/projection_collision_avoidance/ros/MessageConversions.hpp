@@ -32,6 +32,13 @@ Eigen::Vector3d toVector3(const Eigen::Ref<const Eigen::VectorXd>& values);
 bool relativeStateFromMsg(const RelativeMeasurement& msg, int axes, Eigen::VectorXd* state,
                           std::string* why);
 
+/// The leader's input u_1 (@p axes entries) of a LeaderBroadcast, after checking the whole
+/// message: position, velocity and input with @p axes entries, the disturbance empty or with
+/// 2 axes entries, all finite.
+/// @return false, with the reason in @p why, otherwise
+bool leaderInputFromMsg(const LeaderBroadcast& msg, int axes, Eigen::VectorXd* input,
+                        std::string* why);
+
 /// A RelativeMeasurement of the relative state [position; velocity] (2 axes entries).
 RelativeMeasurement toRelativeMeasurementMsg(const Eigen::Ref<const Eigen::VectorXd>& state,
                                              const ros::Time& stamp, const std::string& frame);

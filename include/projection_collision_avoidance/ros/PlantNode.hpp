@@ -14,6 +14,7 @@
 #include "projection_collision_avoidance/AgentIntegrator.hpp"
 #include "projection_collision_avoidance/RelativeMeasurement.h"
 #include "projection_collision_avoidance/Scenario.hpp"
+#include "projection_collision_avoidance/ros/InputGuard.hpp"
 #include "projection_collision_avoidance/ros/RosParameters.hpp"
 
 namespace projection_collision_avoidance {
@@ -28,6 +29,8 @@ struct PlantNodeOptions {
   double noise_velocity = 0.0;              ///< m/s, std dev of the measured relative velocity
   double dropout = 0.0;                     ///< probability that a measurement is dropped
   double latency = 0.0;           ///< s; a measurement sampled at t is published at t + latency
+  double outage_start = 0.0;      ///< s of simulated time at which a measurement outage begins
+  double outage_duration = 0.0;   ///< s; no measurement is sampled in the outage; 0 = none
   int noise_seed = 1;             ///< seed of the noise and dropout draws
   double command_timeout = 0.5;   ///< s; an older command (by its stamp) counts as zero
   bool publish_clock = false;     ///< drive the ticks on wall time and publish /clock
@@ -41,13 +44,15 @@ struct PlantNodeOptions {
 ///
 /// Subscribes `leader/command` and `follower/command` (geometry_msgs/AccelStamped; each held
 /// until replaced, and taken as zero once older than command_timeout; a command that is
-/// non-finite, acts on an axis the model lacks, or is stamped more than command_timeout ahead of
-/// the plant's time is rejected, counted and warned about, throttled). At each tick
-/// t_k = k / rate it publishes `leader/odom`, `follower/odom` (nav_msgs/Odometry), tf
-/// world -> leader and world -> follower, `follower/relative_measurement` (RelativeMeasurement
-/// of x_1 - x_2 with noise, dropout and latency), at most 20 Hz (of simulated time)
+/// non-finite, acts on an axis the model lacks, is not in the agent's frame, is stamped more
+/// than command_timeout ahead of the plant's time or before the last accepted one is rejected,
+/// counted and warned about once per kind). At each tick t_k = k / rate it publishes
+/// `leader/odom`, `follower/odom` (nav_msgs/Odometry), tf world -> leader and
+/// world -> follower, `follower/relative_measurement` (RelativeMeasurement of x_1 - x_2 with
+/// noise, dropout, latency and an optional outage), at most 20 Hz (of simulated time)
 /// `agent_markers` (visualization_msgs/MarkerArray) and, with publish_clock, /clock = t_k; then
-/// it integrates every agent to t_{k+1}.
+/// it integrates every agent to t_{k+1} and publishes the command it held over that step as
+/// `leader/applied_command` and `follower/applied_command`.
 ///
 /// Time: with publish_clock the plant owns simulated time (stamps t_k from 0), ticking on a wall
 /// timer at rate * real_time_factor (catching up ticks that a late callback missed). Otherwise it
@@ -62,19 +67,18 @@ class PlantNode {
   /// One simulated vehicle and its command input.
   struct Agent {
     Agent(const std::string& agent_name, const std::string& tf_frame, const AgentModel& model,
-          double step, const Eigen::VectorXd& initial_state, const SignalProfile& disturbance);
+          double step, const Eigen::VectorXd& initial_state, const SignalProfile& disturbance,
+          double command_timeout);
 
     std::string name;   ///< topic prefix: "leader", "follower"
-    std::string frame;  ///< tf frame
+    std::string frame;  ///< tf frame; commands must carry it as frame_id
     AgentIntegrator<GenericDimensions> integrator;
     Eigen::VectorXd command;  ///< latest accepted command (m/s^2)
-    ros::Time command_stamp;
-    bool have_command = false;
+    InputGuard command_guard;
     bool command_timed_out = false;  ///< the last tick used zero for lack of a fresh command
-    unsigned rejected_commands = 0;
-    std::string last_rejection;
     ros::Subscriber command_subscriber;
     ros::Publisher odom_publisher;
+    ros::Publisher applied_command_publisher;  ///< the command integrated over each tick
   };
 
   /// A follower: its agent, and its relative measurements waiting for their latency.
@@ -82,7 +86,8 @@ class PlantNode {
     Agent agent;
     ros::Publisher measurement_publisher;
     std::deque<RelativeMeasurement> pending;  ///< sampled, in time order, not yet published
-    unsigned dropped = 0;                     ///< measurements dropped so far
+    unsigned dropped = 0;                     ///< measurements dropped so far (not the outage)
+    bool in_outage = false;                   ///< the latest tick lay in the outage
   };
 
   void onCommand(Agent* agent, const geometry_msgs::AccelStamped::ConstPtr& msg);
@@ -92,6 +97,8 @@ class PlantNode {
   /// requests the shutdown).
   bool tick(long k);
   void publishMeasurement(Follower* follower, long k, const ros::Time& stamp);
+  /// Publishes the command the agent's tick k at time t (s) integrates, and integrates it.
+  void advanceAgent(Agent* agent, double t, const ros::Time& stamp);
   void publishMarkers(const ros::Time& stamp);
   /// The held command, or zero when it is absent or older than command_timeout at @p now.
   GenericDimensions::InputVector commandAt(Agent* agent, const ros::Time& now);

@@ -16,7 +16,15 @@
 
 namespace projection_collision_avoidance {
 
-/// The same tree as YAML: structs become maps, arrays sequences, scalars scalars.
+/// Control rates (Hz) the ROS nodes run at: the range of the plant's and the leader's ~rate.
+/// ROS timers do not keep up beyond it, and below it the nodes' timeouts make no sense.
+constexpr double kMinNodeRate = 1.0;
+constexpr double kMaxNodeRate = 10000.0;
+
+/// The same tree as YAML: structs become maps, arrays sequences, scalars scalars. A string
+/// becomes a scalar tagged as a string (like a quoted one), which the scenario loader does not
+/// take for a number or a boolean.
+/// @throws ParameterError (key: the entry's dotted path) for binary data or a date
 YAML::Node toYaml(const XmlRpc::XmlRpcValue& value);
 
 /// Loads the scenario from the private parameter @p name: either a map (the scenario file loaded
@@ -26,7 +34,8 @@ Scenario loadScenarioParameter(const ros::NodeHandle& private_nh,
                                const std::string& name = "scenario");
 
 /// As loadScenarioParameter(), refusing a model other than a double integrator (the ROS nodes
-/// exchange relative positions and velocities) with ParameterError("~<name>/model/type").
+/// exchange relative positions and velocities) with ParameterError("~<name>/model/type") and a
+/// control rate outside [kMinNodeRate, kMaxNodeRate] ("~<name>/controller/control_rate").
 Scenario loadDoubleIntegratorScenario(const ros::NodeHandle& private_nh,
                                       const std::string& name = "scenario");
 

@@ -1,0 +1,26 @@
+# Source lists of the ROS-free libraries, relative to the repository root; shared by the
+# package's CMakeLists.txt and the standalone sanitizer/fuzzer project
+# (test/sanitize/CMakeLists.txt, which prefixes them with the root).
+
+# projection_collision_avoidance_core: every equation of the controller (Eigen and std only).
+set(PCA_CORE_SOURCES
+  src/core/AgentIntegrator.cpp
+  src/core/AgentModel.cpp
+  src/core/ClosedLoopSimulator.cpp
+  src/core/ControllerDesign.cpp
+  src/core/ExactDiscretization.cpp
+  src/core/FollowerController.cpp
+  src/core/FollowerMode.cpp
+  src/core/LinearAlgebra.cpp
+  src/core/RuntimeFollowerController.cpp
+  src/core/Scenario.cpp
+  src/core/ScenarioEmbedding.cpp
+  src/core/SignalProfile.cpp
+  src/core/SimulationCsvWriter.cpp
+)
+
+# projection_collision_avoidance_scenario: scenario files (yaml-cpp) and the cf_sim command.
+set(PCA_SCENARIO_SOURCES
+  src/scenario/CfSimApp.cpp
+  src/scenario/ScenarioLoader.cpp
+)
