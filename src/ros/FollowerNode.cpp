@@ -35,30 +35,6 @@ FollowerNodeOptions readOptions(NodeOptionReader& reader, const ControllerParame
   return options;
 }
 
-visualization_msgs::Marker sphereMarker(const std::string& frame, const ros::Time& stamp,
-                                        const std::string& ns, int id,
-                                        const Eigen::Vector3d& position, double diameter, float r,
-                                        float g, float b, float a) {
-  visualization_msgs::Marker marker;
-  marker.header.frame_id = frame;
-  marker.header.stamp = stamp;
-  marker.ns = ns;
-  marker.id = id;
-  marker.type = visualization_msgs::Marker::SPHERE;
-  marker.action = visualization_msgs::Marker::ADD;
-  marker.pose.position.x = position.x();
-  marker.pose.position.y = position.y();
-  marker.pose.position.z = position.z();
-  marker.pose.orientation.w = 1.0;
-  marker.frame_locked = true;  // follows the follower's tf frame between marker updates
-  marker.scale.x = marker.scale.y = marker.scale.z = diameter;
-  marker.color.r = r;
-  marker.color.g = g;
-  marker.color.b = b;
-  marker.color.a = a;
-  return marker;
-}
-
 }  // namespace
 
 FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
@@ -245,6 +221,7 @@ void FollowerNode::publishStatus(const ros::Time& now, const Eigen::VectorXd& xi
 }
 
 void FollowerNode::publishMarkers(const ros::Time& now, const Eigen::VectorXd& xi) {
+  using visualization_msgs::Marker;
   const ControllerDesign& design = controller_.design();
   const RuntimeFollowerStatus& s = controller_.status();
   const std::string& frame = options_.follower_frame;
@@ -253,32 +230,32 @@ void FollowerNode::publishMarkers(const ros::Time& now, const Eigen::VectorXd& x
   visualization_msgs::MarkerArray markers;
   // Safety perimeter alpha ||d|| around the follower: green, red once the leader is inside.
   // A flat disc on the ground plane (a sphere in 3-D), so the markers above it stay visible.
-  visualization_msgs::Marker perimeter =
-      sphereMarker(frame, now, "perimeter", 0, Eigen::Vector3d::Zero(), 2.0 * design.perimeter,
-                   inside_perimeter ? 1.0F : 0.1F, inside_perimeter ? 0.1F : 0.8F, 0.1F, 0.35F);
+  visualization_msgs::Marker perimeter = toMarker(
+      frame, now, "perimeter", 0, Marker::SPHERE, Eigen::Vector3d::Zero(), 2.0 * design.perimeter,
+      {inside_perimeter ? 1.0F : 0.1F, inside_perimeter ? 0.1F : 0.8F, 0.1F, 0.35F});
   if (axes_ < 3) {
-    perimeter.type = visualization_msgs::Marker::CYLINDER;
+    perimeter.type = Marker::CYLINDER;
     perimeter.scale.z = 0.02;
   }
   markers.markers.push_back(perimeter);
   // The slot x_1 - d, relative to the follower: (p_1 - p_2) - d_p.
   const Eigen::VectorXd slot = relative_state_.head(axes_) - parameters_.separation.head(axes_);
   visualization_msgs::Marker slot_marker =
-      sphereMarker(frame, now, "slot", 0, toVector3(slot), 0.3, 0.8F, 0.8F, 0.8F, 0.9F);
-  slot_marker.type = visualization_msgs::Marker::CUBE;
+      toMarker(frame, now, "slot", 0, Marker::CUBE, toVector3(slot), 0.3, {0.8F, 0.8F, 0.8F, 0.9F});
   markers.markers.push_back(slot_marker);
   // The follower where the CF estimate puts it: p_2 + (xi - xi_hat)_p. Grey in the fallback,
   // where xi is the last measured one and xi_hat a prediction.
   const bool fallback = mode_ == FollowerMode::kMeasurementLost;
   const Eigen::VectorXd ghost = (xi - s.estimate).head(axes_);
-  markers.markers.push_back(sphereMarker(frame, now, "cf_estimate", 0, toVector3(ghost), 0.5,
-                                         fallback ? 0.5F : 1.0F, fallback ? 0.5F : 0.55F,
-                                         fallback ? 0.5F : 0.0F, 0.45F));
+  const MarkerColor ghost_color =
+      fallback ? MarkerColor{0.5F, 0.5F, 0.5F, 0.45F} : MarkerColor{1.0F, 0.55F, 0.0F, 0.45F};
+  markers.markers.push_back(
+      toMarker(frame, now, "cf_estimate", 0, Marker::SPHERE, toVector3(ghost), 0.5, ghost_color));
   // ||xi|| against xi_max, as text above the follower; the mode unless tracking.
   const float shade = xi.norm() > design.xi_max || fallback ? 0.2F : 1.0F;  // red: trouble
-  visualization_msgs::Marker text = sphereMarker(
-      frame, now, "bound", 0, Eigen::Vector3d(0.0, 0.0, 1.2), 0.35, 1.0F, shade, shade, 1.0F);
-  text.type = visualization_msgs::Marker::TEXT_VIEW_FACING;
+  visualization_msgs::Marker text =
+      toMarker(frame, now, "bound", 0, Marker::TEXT_VIEW_FACING, Eigen::Vector3d(0.0, 0.0, 1.2),
+               0.35, {1.0F, shade, shade, 1.0F});
   std::ostringstream label;
   label << std::fixed << std::setprecision(2) << "|xi| " << xi.norm() << " / xi_max "
         << design.xi_max << " m";

@@ -139,4 +139,28 @@ geometry_msgs::TransformStamped toTransformMsg(const Eigen::Ref<const Eigen::Vec
   return msg;
 }
 
+visualization_msgs::Marker toMarker(const std::string& frame, const ros::Time& stamp,
+                                    const std::string& ns, int id, int type,
+                                    const Eigen::Vector3d& position, double size,
+                                    const MarkerColor& color) {
+  visualization_msgs::Marker marker;
+  marker.header.frame_id = frame;
+  marker.header.stamp = stamp;
+  marker.ns = ns;
+  marker.id = id;
+  marker.type = type;
+  marker.action = visualization_msgs::Marker::ADD;
+  marker.pose.position.x = position.x();
+  marker.pose.position.y = position.y();
+  marker.pose.position.z = position.z();
+  marker.pose.orientation.w = 1.0;
+  marker.frame_locked = true;
+  marker.scale.x = marker.scale.y = marker.scale.z = size;
+  marker.color.r = color.r;
+  marker.color.g = color.g;
+  marker.color.b = color.b;
+  marker.color.a = color.a;
+  return marker;
+}
+
 }  // namespace projection_collision_avoidance

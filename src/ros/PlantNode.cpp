@@ -75,32 +75,12 @@ PlantNodeOptions readOptions(NodeOptionReader& reader, const Scenario& scenario)
   return o;
 }
 
-visualization_msgs::Marker agentMarker(const std::string& frame, const ros::Time& stamp,
-                                       const std::string& ns, int id, int type, double size,
-                                       float r, float g, float b) {
-  visualization_msgs::Marker marker;
-  marker.header.frame_id = frame;
-  marker.header.stamp = stamp;
-  marker.ns = ns;
-  marker.id = id;
-  marker.type = type;
-  marker.action = visualization_msgs::Marker::ADD;
-  marker.pose.orientation.w = 1.0;
-  marker.scale.x = marker.scale.y = marker.scale.z = size;
-  marker.color.r = r;
-  marker.color.g = g;
-  marker.color.b = b;
-  marker.color.a = 1.0F;
-  marker.frame_locked = true;  // follows its tf frame between marker updates
-  return marker;
-}
-
 visualization_msgs::Marker labelMarker(const std::string& frame, const ros::Time& stamp, int id,
                                        const std::string& text, double height) {
-  visualization_msgs::Marker marker = agentMarker(
-      frame, stamp, "labels", id, visualization_msgs::Marker::TEXT_VIEW_FACING, 0.3, 1, 1, 1);
+  visualization_msgs::Marker marker =
+      toMarker(frame, stamp, "labels", id, visualization_msgs::Marker::TEXT_VIEW_FACING,
+               Eigen::Vector3d(0.0, 0.0, height), 0.3, MarkerColor{});
   marker.scale.x = marker.scale.y = 0.0;
-  marker.pose.position.z = height;
   marker.text = text;
   return marker;
 }
@@ -388,13 +368,13 @@ void PlantNode::publishMeasurement(Follower* follower, long k, const ros::Time& 
 void PlantNode::publishMarkers(const ros::Time& stamp) {
   using visualization_msgs::Marker;
   visualization_msgs::MarkerArray markers;
-  markers.markers.push_back(
-      agentMarker(leader_.frame, stamp, "agents", 0, Marker::CUBE, 0.6, 0.1F, 0.3F, 1.0F));
+  markers.markers.push_back(toMarker(leader_.frame, stamp, "agents", 0, Marker::CUBE,
+                                     Eigen::Vector3d::Zero(), 0.6, {0.1F, 0.3F, 1.0F, 1.0F}));
   markers.markers.push_back(labelMarker(leader_.frame, stamp, 0, leader_.name, 0.7));
   int id = 1;
   for (const Follower& follower : followers_) {
-    markers.markers.push_back(agentMarker(follower.agent.frame, stamp, "agents", id, Marker::SPHERE,
-                                          0.5, 1.0F, 0.55F, 0.0F));
+    markers.markers.push_back(toMarker(follower.agent.frame, stamp, "agents", id, Marker::SPHERE,
+                                       Eigen::Vector3d::Zero(), 0.5, {1.0F, 0.55F, 0.0F, 1.0F}));
     markers.markers.push_back(
         labelMarker(follower.agent.frame, stamp, id, follower.agent.name, 0.6));
     ++id;

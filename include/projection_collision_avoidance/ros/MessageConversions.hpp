@@ -12,6 +12,7 @@
 #include <geometry_msgs/TransformStamped.h>
 #include <nav_msgs/Odometry.h>
 #include <ros/time.h>
+#include <visualization_msgs/Marker.h>
 
 #include "projection_collision_avoidance/LeaderBroadcast.h"
 #include "projection_collision_avoidance/RelativeMeasurement.h"
@@ -61,6 +62,21 @@ nav_msgs::Odometry toOdometryMsg(const Eigen::Ref<const Eigen::VectorXd>& state,
 
 /// The state [p; v] (2 axes entries) of an Odometry; false if non-finite.
 bool stateFromOdometryMsg(const nav_msgs::Odometry& msg, int axes, Eigen::VectorXd* state);
+
+/// Colour of a marker: red, green, blue, alpha in [0, 1].
+struct MarkerColor {
+  float r = 1.0F;
+  float g = 1.0F;
+  float b = 1.0F;
+  float a = 1.0F;
+};
+
+/// A marker of @p type (visualization_msgs::Marker::SPHERE, ...) at @p position in @p frame,
+/// scaled @p size on every axis, frame-locked (it follows its tf frame between updates).
+visualization_msgs::Marker toMarker(const std::string& frame, const ros::Time& stamp,
+                                    const std::string& ns, int id, int type,
+                                    const Eigen::Vector3d& position, double size,
+                                    const MarkerColor& color);
 
 /// The transform of a frame at @p position (1-3 entries) with identity rotation.
 geometry_msgs::TransformStamped toTransformMsg(const Eigen::Ref<const Eigen::VectorXd>& position,
