@@ -1,5 +1,6 @@
 /// The three nodes as nodelets: each owns the same class the stand-alone node runs.
 
+#include <exception>
 #include <memory>
 
 #include <nodelet/nodelet.h>
@@ -13,7 +14,8 @@
 namespace projection_collision_avoidance {
 
 /// Runs Node(node handle, private node handle) inside a nodelet manager. A refused parameter is
-/// logged with its key and fails the load (the manager's process is not ended).
+/// logged with its key, any other failure with its message, and the load fails (the manager's
+/// process is not ended).
 template <typename Node>
 class NodeletOf : public nodelet::Nodelet {
  private:
@@ -22,6 +24,9 @@ class NodeletOf : public nodelet::Nodelet {
       node_ = std::make_unique<Node>(getNodeHandle(), getPrivateNodeHandle());
     } catch (const ParameterError& error) {
       NODELET_FATAL_STREAM(getName() << ": invalid parameter " << error.what());
+      throw;
+    } catch (const std::exception& error) {
+      NODELET_FATAL_STREAM(getName() << ": failed: " << error.what());
       throw;
     }
   }
