@@ -10,6 +10,7 @@ packages=(
   catkin python3-catkin-pkg catkin-lint
   libeigen3-dev libyaml-cpp-dev
   googletest libgtest-dev libbenchmark-dev
+  clang libclang-rt-14-dev llvm  # scripts/sanitize.sh: ASan, UBSan, libFuzzer, llvm-symbolizer
   python3-yaml python3-numpy python3-scipy python3-matplotlib
   ros-core-dev libtf2-ros-dev libtf2-eigen-dev libdiagnostic-updater-dev
   libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure

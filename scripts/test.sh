@@ -3,7 +3,9 @@
 #  1. standalone build (cmake + make), all tests (gtest + cross-check with the SciPy reference),
 #     read back with catkin_test_results;
 #  2. the everyday ROS routes: the package in a fresh workspace built with catkin_make and with
-#     catkin build (catkin-tools).
+#     catkin build (catkin-tools);
+#  3. scripts/sanitize.sh: the core gtests under ASan + UBSan (clang, standalone CMake project) and
+#     a short libFuzzer run ($SANITIZE_FUZZ_SECONDS, default 25 s).
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 
@@ -21,20 +23,7 @@ make -C "$build_dir" run_tests >"$build_dir/run_tests.log" 2>&1 || {
 results_ok=true
 catkin_test_results --verbose "$build_dir/test_results" || results_ok=false
 # Count test cases from the JUnit files: "passed failed skipped".
-read -r passed failed skipped < <(/usr/bin/python3 - "$build_dir/test_results" <<'PY'
-import pathlib, sys, xml.etree.ElementTree as ET
-passed = failed = skipped = 0
-for path in pathlib.Path(sys.argv[1]).rglob("*.xml"):
-    for case in ET.parse(path).getroot().iter("testcase"):
-        if case.find("failure") is not None or case.find("error") is not None:
-            failed += 1
-        elif case.find("skipped") is not None or case.get("status") == "notrun":
-            skipped += 1
-        else:
-            passed += 1
-print(passed, failed, skipped)
-PY
-)
+read -r passed failed skipped < <(/usr/bin/python3 "$root/scripts/count_test_results.py" "$build_dir/test_results")
 if [[ $results_ok != true || $failed -ne 0 || $passed -eq 0 ]]; then
   echo "$passed passed, $failed failed"
   echo "test: failing tests above"
@@ -61,4 +50,15 @@ for tool in catkin_make catkin_build; do
   echo "$tool: built"
 done
 
-echo "$passed passed, $failed failed, $skipped skipped"
+echo "== sanitizers and fuzzing"
+sanitize_dir=${SANITIZE_BUILD_DIR:-$root/build-sanitize}
+fuzz_seconds=${SANITIZE_FUZZ_SECONDS:-25}
+SANITIZE_BUILD_DIR=$sanitize_dir "$root/scripts/sanitize.sh" --fuzz-seconds "$fuzz_seconds" || {
+  echo "$passed passed, $failed failed, $skipped skipped; sanitizer build or fuzzing FAILED"
+  echo "test: scripts/sanitize.sh failed"
+  exit 1
+}
+# The same count over the sanitizer build's gtest XML.
+read -r san_passed san_failed san_skipped < <(/usr/bin/python3 "$root/scripts/count_test_results.py" "$sanitize_dir/test_results")
+echo "$passed passed, $failed failed, $skipped skipped" \
+  "(and under ASan + UBSan: $san_passed passed, $san_failed failed; fuzzed $fuzz_seconds s)"

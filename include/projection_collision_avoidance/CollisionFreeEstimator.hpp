@@ -1,6 +1,8 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include "projection_collision_avoidance/BallConstraint.hpp"
@@ -15,6 +17,10 @@ struct EstimatorPeriodReport {
   bool projection_active = false;    ///< the projection changed the drift in some substep
   double boundary_correction = 0.0;  ///< largest distance (m) by which a substep's result was
                                      ///< moved back onto the sphere ||xi_hat|| = xi_max
+  /// A substep's result (or the held input itself) was not finite, an overflow with huge finite
+  /// inputs or gains: the estimate was held at its value before that substep for the rest of the
+  /// period.
+  bool estimate_held = false;
 };
 
 /// The collision-free (CF) estimator: a Luenberger observer of the relative error xi whose drift
@@ -23,8 +29,11 @@ struct EstimatorPeriodReport {
 /// Between two control ticks the measurement y and the tracker input u_a are held; the estimate
 /// is integrated with classical Runge-Kutta (RK4) substeps of the projected drift. The flow
 /// keeps Omega_1 invariant; RK4 can leave it by its local truncation error (order h^5), and any
-/// such excess is removed by scaling the estimate back onto the sphere, so ||xi_hat|| <= xi_max
-/// holds exactly after every substep. The size of that correction is reported.
+/// such excess is removed by scaling the estimate back onto the sphere (16 ulps inside it), so
+/// ||xi_hat|| <= xi_max holds exactly after every substep, in any evaluation of the norm. The
+/// size of that correction is reported. The estimate is always finite: a substep whose result is
+/// not (an overflow with huge finite inputs or gains) is discarded and the estimate held, which
+/// the report says.
 template <typename Dims>
 class CollisionFreeEstimator {
  public:
@@ -55,9 +64,33 @@ class CollisionFreeEstimator {
     estimate_ = StateVector::Zero(n);
   }
 
-  /// Sets the estimate, scaled into Omega_1 if it lies outside.
+  /// Sets the estimate, scaled into Omega_1 if it lies outside; zero if it is not finite.
   void reset(const StateVector& estimate) {
     estimate_ = estimate;
+    if (!estimate_.allFinite()) {
+      estimate_.setZero();
+    }
+    moveIntoBound(&estimate_);
+  }
+
+  /// Sets the estimate to scale * direction (scale >= 0), scaled into Omega_1 if it lies
+  /// outside, also when that product overflows: then it is put on the sphere along direction.
+  /// Zero if direction or scale is not finite.
+  void reset(const StateVector& direction, double scale) {
+    estimate_ = scale * direction;
+    if (estimate_.allFinite()) {
+      moveIntoBound(&estimate_);
+      return;
+    }
+    if (!direction.allFinite() || !std::isfinite(scale)) {
+      estimate_.setZero();
+      return;
+    }
+    // ||scale direction|| > DBL_MAX: outside any representable ball. On the sphere (or, for an
+    // unbounded Omega_1, a sphere of representable radius) along the direction.
+    estimate_ = direction / direction.cwiseAbs().maxCoeff();
+    estimate_ /= euclideanNorm(estimate_);
+    estimate_ *= std::min(constraint_.hardRadius(), 0.25 * kLargest);
     moveIntoBound(&estimate_);
   }
 
@@ -109,10 +142,15 @@ class CollisionFreeEstimator {
   }
 
   /// RK4 over one period of xi_hat' = Proj(F xi_hat + c), c held; after each substep the
-  /// estimate is moved back into Omega_1 if the substep's truncation error left it outside.
+  /// estimate is moved back into Omega_1 if the substep's truncation error left it outside. A
+  /// substep whose result is not finite is discarded, and the estimate held from there on.
   EstimatorPeriodReport integrate(const StateMatrix& F, const StateVector& c, double period,
                                   int substeps) {
     EstimatorPeriodReport report;
+    if (!c.allFinite()) {
+      report.estimate_held = true;
+      return report;
+    }
     bool* active = &report.projection_active;
     const double h = period / substeps;
     for (int i = 0; i < substeps; ++i) {
@@ -120,27 +158,31 @@ class CollisionFreeEstimator {
       const StateVector k2 = projectedDerivative(F, estimate_ + (0.5 * h) * k1, c, active);
       const StateVector k3 = projectedDerivative(F, estimate_ + (0.5 * h) * k2, c, active);
       const StateVector k4 = projectedDerivative(F, estimate_ + h * k3, c, active);
-      estimate_ += (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
-      const double correction = moveIntoBound(&estimate_);
+      StateVector next = estimate_ + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+      if (!next.allFinite()) {
+        report.estimate_held = true;
+        break;  // c is held: every further substep from here would overflow alike
+      }
+      const double correction = moveIntoBound(&next);
       report.boundary_correction = std::max(report.boundary_correction, correction);
+      estimate_ = next;
     }
     return report;
   }
 
-  /// Scales @p x onto the sphere of radius xi_max if it lies outside; returns the distance moved.
+  /// Scales the finite @p x onto the sphere of radius xi_max (1 - kBoundMargin) if it lies
+  /// outside (clampNorm()); returns the distance moved (m), infinite if ||x|| exceeds DBL_MAX.
+  /// The margin, 16 ulps relative, covers the rounding of any order of summing ||x||^2 (up to 12
+  /// entries), so that ||xi_hat|| <= xi_max holds however the norm is evaluated (Eigen's norm()
+  /// sums fixed- and dynamic-size vectors in different orders).
   double moveIntoBound(StateVector* x) const {
-    const double radius = constraint_.hardRadius();
-    const double norm = x->norm();
-    if (!(norm > radius)) {
-      return 0.0;
-    }
-    *x *= radius / norm;
-    // Rounding can leave the scaled vector an ulp outside; shrink until it is not.
-    while (x->norm() > radius) {
-      *x *= 1.0 - 2.0 * Eigen::NumTraits<double>::epsilon();
-    }
-    return norm - radius;
+    const double radius = constraint_.hardRadius() * (1.0 - kBoundMargin);
+    const double norm = clampNorm(*x, radius);
+    return norm > 0.0 ? norm - radius : 0.0;
   }
+
+  static constexpr double kBoundMargin = 16.0 * std::numeric_limits<double>::epsilon();
+  static constexpr double kLargest = std::numeric_limits<double>::max();
 
   BallConstraint constraint_;
   StateMatrix estimator_matrix_;      // A_c + L C

@@ -1,5 +1,6 @@
 #pragma once
 
+#include "projection_collision_avoidance/BallConstraint.hpp"
 #include "projection_collision_avoidance/CollisionFreeEstimator.hpp"
 #include "projection_collision_avoidance/CollisionFreeTracker.hpp"
 #include "projection_collision_avoidance/ControllerDesign.hpp"
@@ -16,12 +17,23 @@ struct FollowerControllerStatus {
   typename Dims::InputVector feedforward_command;  ///< u_1 when shared into the command, else 0
   typename Dims::InputVector fallback_command;     ///< K_f xi_hat in the fallback, else 0
   typename Dims::StateVector estimate;             ///< xi_hat used at this tick (m)
-  double estimate_norm = 0.0;                      ///< ||xi_hat|| (m)
+  double estimate_norm = 0.0;                      ///< ||xi_hat|| (m), euclideanNorm()
   double constraint_value = 0.0;                   ///< f(xi_hat) (13)
   bool command_saturated = false;    ///< the sum exceeded acceleration_limit and was scaled
-  bool fallback = false;             ///< this tick ran the fallback (no measurement)
+  bool fallback = false;             ///< this tick ran the fallback (no usable measurement)
   bool projection_active = false;    ///< the projection acted during the period that follows
   double boundary_correction = 0.0;  ///< see EstimatorPeriodReport (m)
+  /// step() got a measurement with a non-finite entry: it was treated as missing, and this tick
+  /// ran the fallback (stepFallback()) instead.
+  bool measurement_rejected = false;
+  /// The leader's input u_1 had a non-finite entry: this tick took it as unknown.
+  bool leader_input_rejected = false;
+  /// The laws' command was not finite (an overflow with huge finite measurements, inputs or
+  /// gains) and was replaced: in step() by the fallback's for this tick (fallback is set), in the
+  /// fallback by the feed-forward u_ff alone (zero when u_1 is not shared), saturated.
+  bool command_overflow = false;
+  /// The estimator discarded a non-finite substep and held the estimate (EstimatorPeriodReport).
+  bool estimate_held = false;
 };
 
 /// The follower's controller: baseline law (2) augmented (10) by the CF tracker (19), which
@@ -34,6 +46,12 @@ struct FollowerControllerStatus {
 /// the augmentation that actually acts, u_2 - G y - u_ff (u_a when not saturated), so that its
 /// model of xi' stays that of the plant. Without a measurement stepFallback() brakes relative to
 /// the leader from the predicted estimate instead. A step allocates no memory.
+///
+/// Whatever the inputs, after every call the command is finite with euclideanNorm(u_2) <=
+/// acceleration_limit, and the estimate is finite with euclideanNorm(xi_hat) <= xi_max: a
+/// non-finite measurement is treated as missing, a non-finite u_1 as unknown, a command that
+/// overflows is replaced by a finite one, and an estimator substep that overflows is discarded;
+/// each is flagged in the status.
 template <typename Dims>
 class FollowerController {
  public:
@@ -60,17 +78,26 @@ class FollowerController {
   }
 
   /// One control period without leader information (u_1 taken as unknown).
-  /// @param y relative measurement C (x_1 - x_2 - d), finite
+  ///
+  /// A measurement with a non-finite entry (NaN, +-inf) does not reach the laws or the
+  /// estimator: it counts as missing, the tick runs the fallback exactly as stepFallback() does,
+  /// and status.measurement_rejected (with status.fallback) says so. A finite measurement so
+  /// large that the laws' command G y + u_a + u_ff overflows runs the fallback as well, flagged
+  /// status.command_overflow. So the command is always finite with ||u_2|| <=
+  /// acceleration_limit (in euclideanNorm()), and the estimate finite with ||xi_hat|| <= xi_max.
+  /// @param y relative measurement C (x_1 - x_2 - d)
   /// @return the status of this tick; status.command is u_2 (m/s^2 for double integrators)
   const FollowerControllerStatus<Dims>& step(const OutputVector& y) {
-    return advance(y, InputVector::Zero(input_matrix_.cols()), false);
+    return tick(&y, InputVector::Zero(input_matrix_.cols()), false);
   }
 
   /// One control period with the leader's current input u_1 (used as configured by
-  /// leader_input_in_command / leader_input_in_estimator).
+  /// leader_input_in_command / leader_input_in_estimator). A u_1 with a non-finite entry is
+  /// taken as unknown for this tick (status.leader_input_rejected), as in step(y); a non-finite
+  /// y is handled as in step(y).
   const FollowerControllerStatus<Dims>& step(const OutputVector& y,
                                              const InputVector& leader_input) {
-    return advance(y, leader_input, true);
+    return tick(&y, leader_input, true);
   }
 
   /// One control period without a measurement: the fallback. The command brakes relative to
@@ -79,20 +106,23 @@ class FollowerController {
   /// with u_ff and u_1m the leader input as shared into the command and the estimator (0 when
   /// unknown). For the default K_f = [0, k_v I] of a double integrator the predicted relative
   /// velocity decays as e^{-k_v t} and the relative position comes to rest. Before any
-  /// measurement the estimate is the one the next step() would replace, zero.
+  /// measurement the estimate is the one the next step() would replace, zero. If u_ff + K_f
+  /// xi_hat overflows (huge gains), the command is u_ff alone, saturated (command_overflow).
   const FollowerControllerStatus<Dims>& stepFallback() {
-    return fallback(InputVector::Zero(input_matrix_.cols()), false);
+    return tick(nullptr, InputVector::Zero(input_matrix_.cols()), false);
   }
 
-  /// The fallback with the leader's current input u_1 (see stepFallback()).
+  /// The fallback with the leader's current input u_1 (see stepFallback()); a u_1 with a
+  /// non-finite entry is taken as unknown (status.leader_input_rejected).
   const FollowerControllerStatus<Dims>& stepFallback(const InputVector& leader_input) {
-    return fallback(leader_input, true);
+    return tick(nullptr, leader_input, true);
   }
 
   /// Forgets the estimate; the next step initialises it as configured.
   void reset() { initialized_ = false; }
 
-  /// Sets the estimate (projected into Omega_1) and marks the controller initialised.
+  /// Sets the estimate (projected into Omega_1; zero if not finite) and marks the controller
+  /// initialised.
   void resetEstimate(const StateVector& estimate) {
     estimator_.reset(estimate);
     initialized_ = true;
@@ -108,31 +138,67 @@ class FollowerController {
   const CollisionFreeEstimator<Dims>& estimator() const { return estimator_; }
 
  private:
-  const FollowerControllerStatus<Dims>& advance(const OutputVector& y,
-                                                const InputVector& leader_input,
-                                                bool leader_input_known) {
+  /// One tick: checks the inputs, then runs the laws (y given and finite) or the fallback.
+  const FollowerControllerStatus<Dims>& tick(const OutputVector* y, const InputVector& leader_input,
+                                             bool leader_input_known) {
+    status_.measurement_rejected = false;
+    status_.leader_input_rejected = false;
+    status_.command_overflow = false;
+    status_.estimate_held = false;
+    if (leader_input_known && !leader_input.allFinite()) {
+      status_.leader_input_rejected = true;
+      leader_input_known = false;
+    }
+    if (y != nullptr && !y->allFinite()) {
+      status_.measurement_rejected = true;
+      y = nullptr;
+    }
+    if (y != nullptr && advance(*y, leader_input, leader_input_known)) {
+      return status_;
+    }
+    return fallback(leader_input, leader_input_known);
+  }
+
+  /// Initialises the estimate from the finite y as configured.
+  void initialize(const OutputVector& y) {
+    if (design_.parameters.initial_estimate == InitialEstimate::kZero) {
+      estimator_.reset(StateVector::Zero(input_matrix_.rows()));
+    } else {
+      const StateVector initial = output_pseudoinverse_ * y;
+      if (initial.allFinite()) {
+        estimator_.reset(initial);
+      } else {  // pinv(C) y overflows: keep its direction, scaled
+        const double scale = y.cwiseAbs().maxCoeff();
+        estimator_.reset(output_pseudoinverse_ * (y / scale), scale);
+      }
+    }
+    initialized_ = true;
+  }
+
+  /// The laws for the finite y; false, with nothing changed but the initialisation and
+  /// command_overflow set, if their command is not finite.
+  bool advance(const OutputVector& y, const InputVector& leader_input, bool leader_input_known) {
     const ControllerParameters& p = design_.parameters;
     if (!initialized_) {
-      if (p.initial_estimate == InitialEstimate::kMeasurement) {
-        estimator_.reset(output_pseudoinverse_ * y);
-      } else {
-        estimator_.reset(StateVector::Zero(input_matrix_.rows()));
-      }
-      initialized_ = true;
+      initialize(y);
     }
     const StateVector& estimate = estimator_.estimate();
     const OutputVector estimated_output = output_matrix_ * estimate;
 
-    status_.estimate = estimate;
-    status_.estimate_norm = estimate.norm();
-    status_.constraint_value = estimator_.constraint().value(estimate);
     status_.baseline_command = baseline_gain_ * y;
     status_.tracker_command = tracker_.command(y, estimated_output);
-    status_.fallback_command.setZero();
-    status_.fallback = false;
     setFeedforward(leader_input, leader_input_known);
     status_.command =
         status_.baseline_command + status_.tracker_command + status_.feedforward_command;
+    if (!status_.command.allFinite()) {
+      status_.command_overflow = true;
+      return false;
+    }
+    status_.estimate = estimate;
+    status_.estimate_norm = euclideanNorm(estimate);
+    status_.constraint_value = estimator_.constraint().value(estimate);
+    status_.fallback_command.setZero();
+    status_.fallback = false;
     saturateCommand();
     InputVector acting_augmentation = status_.tracker_command;
     if (status_.command_saturated) {
@@ -145,7 +211,8 @@ class FollowerController {
                                                             design_.period, p.estimator_substeps);
     status_.projection_active = report.projection_active;
     status_.boundary_correction = report.boundary_correction;
-    return status_;
+    status_.estimate_held = report.estimate_held;
+    return true;
   }
 
   const FollowerControllerStatus<Dims>& fallback(const InputVector& leader_input,
@@ -153,7 +220,7 @@ class FollowerController {
     const ControllerParameters& p = design_.parameters;
     const StateVector& estimate = estimator_.estimate();
     status_.estimate = estimate;
-    status_.estimate_norm = estimate.norm();
+    status_.estimate_norm = euclideanNorm(estimate);
     status_.constraint_value = estimator_.constraint().value(estimate);
     status_.baseline_command.setZero();
     status_.tracker_command.setZero();
@@ -161,6 +228,11 @@ class FollowerController {
     setFeedforward(leader_input, leader_input_known);
     status_.fallback_command = fallback_gain_ * estimate;
     status_.command = status_.feedforward_command + status_.fallback_command;
+    if (!status_.command.allFinite()) {  // K_f xi_hat overflows: u_ff alone (finite)
+      status_.command_overflow = true;
+      status_.fallback_command.setZero();
+      status_.command = status_.feedforward_command;
+    }
     saturateCommand();
 
     // xi' = A xi + B (u_1 - u_ff) - B (u_2 - u_ff), with u_1 - u_ff modelled as in step().
@@ -170,6 +242,7 @@ class FollowerController {
         estimator_.predict(drift, design_.period, p.estimator_substeps);
     status_.projection_active = report.projection_active;
     status_.boundary_correction = report.boundary_correction;
+    status_.estimate_held = report.estimate_held;
     return status_;
   }
 
@@ -188,14 +261,11 @@ class FollowerController {
     }
   }
 
-  /// Scales status_.command onto acceleration_limit when it is longer.
+  /// Scales the finite status_.command onto acceleration_limit when it is longer (clampNorm():
+  /// no overflow, and euclideanNorm(command) <= acceleration_limit exactly).
   void saturateCommand() {
-    const double limit = design_.parameters.acceleration_limit;
-    const double norm = status_.command.norm();
-    status_.command_saturated = norm > limit;
-    if (status_.command_saturated) {
-      status_.command *= limit / norm;
-    }
+    status_.command_saturated =
+        clampNorm(status_.command, design_.parameters.acceleration_limit) > 0.0;
   }
 
   ControllerDesign design_;

@@ -22,9 +22,13 @@ struct RuntimeFollowerStatus {
   double estimate_norm = 0.0;           ///< ||xi_hat|| (m)
   double constraint_value = 0.0;        ///< f(xi_hat) (13)
   bool command_saturated = false;       ///< the command was scaled onto acceleration_limit
-  bool fallback = false;                ///< this tick ran the fallback (no measurement)
+  bool fallback = false;                ///< this tick ran the fallback (no usable measurement)
   bool projection_active = false;
-  double boundary_correction = 0.0;  ///< (m)
+  double boundary_correction = 0.0;    ///< (m)
+  bool measurement_rejected = false;   ///< y had a non-finite entry: treated as missing
+  bool leader_input_rejected = false;  ///< u_1 had a non-finite entry: taken as unknown
+  bool command_overflow = false;       ///< the laws' command was not finite and was replaced
+  bool estimate_held = false;          ///< an estimator substep overflowed and was discarded
 };
 
 /// A FollowerController whose compile-time dimensions are chosen at run time from the model
@@ -35,8 +39,10 @@ class RuntimeFollowerController {
   /// @param design validated parameters
   explicit RuntimeFollowerController(const ControllerDesign& design);
 
-  /// One control period (see FollowerController::step()).
-  /// @param y measurement C xi, outputDimension() entries, finite
+  /// One control period (see FollowerController::step()): a y with a non-finite entry is
+  /// treated as missing (the fallback runs, status.measurement_rejected), and the command is
+  /// always finite with ||u_2|| <= acceleration_limit.
+  /// @param y measurement C xi, outputDimension() entries
   const RuntimeFollowerStatus& step(const Eigen::Ref<const Eigen::VectorXd>& y);
 
   /// One control period with the leader's input u_1 (inputDimension() entries).

@@ -22,6 +22,10 @@ void copyStatus(const FollowerControllerStatus<Dims>& from, RuntimeFollowerStatu
   to->fallback = from.fallback;
   to->projection_active = from.projection_active;
   to->boundary_correction = from.boundary_correction;
+  to->measurement_rejected = from.measurement_rejected;
+  to->leader_input_rejected = from.leader_input_rejected;
+  to->command_overflow = from.command_overflow;
+  to->estimate_held = from.estimate_held;
 }
 
 }  // namespace
