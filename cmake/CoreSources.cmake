@@ -8,9 +8,11 @@ set(PCA_CORE_SOURCES
   src/core/AgentModel.cpp
   src/core/ClosedLoopSimulator.cpp
   src/core/ControllerDesign.cpp
+  src/core/DisturbanceSweep.cpp
   src/core/ExactDiscretization.cpp
   src/core/FollowerController.cpp
   src/core/FollowerMode.cpp
+  src/core/Formation.cpp
   src/core/LinearAlgebra.cpp
   src/core/RuntimeFollowerController.cpp
   src/core/Scenario.cpp

@@ -13,11 +13,12 @@ State and equations (all continuous in time)::
 
     xi     = x_1 - x_2 - d,   y = C xi,   y_hat = C xi_hat
     u_a    = G_e (y - y_hat) + S_21 y_hat         (tracker enabled, else 0)
-    u_ff   = u_1                                  (leader_information.command, else 0)
+    a_1    = u_1 + pinv(B) u_d(t)                 (leader_information.disturbance, else u_1)
+    u_ff   = a_1                                  (leader_information.command, else 0)
     u_2    = G y + u_a + u_ff
     x_1'   = A x_1 + B u_1(t) + u_d(t)
     x_2'   = A x_2 + B u_2
-    h      = A_c xi_hat - B u_a + L (y_hat - y)   [+ B (u_1 - u_ff) if
+    h      = A_c xi_hat - B u_a + L (y_hat - y)   [+ B (a_1 - u_ff) if
                                                    leader_information.estimator]
     xi_hat' = h - f Gamma^-1 grad_f (grad_f^T h) / (grad_f^T Gamma^-1 grad_f)
                                                   if f > 0 and grad_f^T h > 0
@@ -25,6 +26,17 @@ State and equations (all continuous in time)::
 
 with A_c = A - B G C, Gamma (A_c + L C) + (A_c + L C)^T Gamma = -Q and
 f = ((1 + eps) ||xi_hat||^2 - xi_max^2) / (eps xi_max^2), xi_max = (1 - alpha) ||d||.
+
+a_1 is the leader acceleration that the follower is told (leader_information):
+with ``disturbance: true`` it includes the part of the leader's disturbance
+that acts through B, pinv(B) u_d (for a double integrator the velocity-rate
+half of u_d); the rest, (I - B pinv(B)) u_d (the position-rate half), reaches
+the follower through xi only. The flag matters only when ``command`` or
+``estimator`` is on. With both on, B (a_1 - u_ff) = 0: the estimator then
+needs no model of the fed-forward acceleration, which cancels in xi'.
+
+Only the paper's pair is covered: a scenario with a ``formation`` section is
+refused (exit 2) unless it has followers: 1 and the line shape, which is the pair.
 
 The input and disturbance pulses make the right-hand side discontinuous in time,
 so the integration is restarted at every pulse edge. Inside a segment the
@@ -94,7 +106,7 @@ SCHEMA = {
             "initial_estimate": None,
         },
         "tracker": {"enabled": None, "reference_gain": None, **_GAIN},
-        "leader_information": {"command": None, "estimator": None},
+        "leader_information": {"command": None, "estimator": None, "disturbance": None},
     },
     "leader": {
         "initial_state": None,
@@ -103,6 +115,7 @@ SCHEMA = {
     },
     "follower": {"initial_state": None},
     "simulation": {"duration": None},
+    "formation": {"followers": None, "topology": None, "shape": None, "half_angle": None},
 }
 
 
@@ -271,6 +284,7 @@ class Scenario:
     S21: np.ndarray
     info_command: bool
     info_estimator: bool
+    info_disturbance: bool
     x1_0: np.ndarray
     x2_0: np.ndarray
     input_pulses: list = field(default_factory=list)   # (start, end, m-vector)
@@ -288,6 +302,7 @@ class Scenario:
         self.perimeter = self.alpha * float(np.linalg.norm(self.d))
         self.Gamma = lyapunov_gamma(self.F, self.Q)
         self.Gamma_inv = np.linalg.inv(self.Gamma)
+        self.B_pinv = np.linalg.pinv(self.B)
 
 
 def lyapunov_gamma(F, Q):
@@ -346,11 +361,30 @@ def _pulses(items, path, size):
     return out
 
 
+def check_single_pair(formation):
+    """Refuse a formation: the reference simulates the leader-follower pair only."""
+    if formation is None:
+        return
+    followers = get(formation, "followers", "formation")
+    if isinstance(followers, bool) or not isinstance(followers, int):
+        raise ScenarioError(f"formation.followers: expected an integer, got {followers!r}")
+    if followers != 1:
+        raise ScenarioError(
+            f"formation.followers = {followers}: formations are not covered by the "
+            "reference, which simulates one leader-follower pair (followers: 1)")
+    shape = formation.get("shape", "line")
+    if shape != "line":
+        raise ScenarioError(
+            f"formation.shape = {shape!r}: only the line shape (the pair on d) is covered "
+            "by the reference")
+
+
 def build_scenario(raw):
     """Validate the raw YAML tree and return a Scenario."""
     if not isinstance(raw, dict):
         raise ScenarioError("the scenario must be a YAML mapping")
     check_keys(raw, SCHEMA)
+    check_single_pair(raw.get("formation"))
 
     model = get(raw, "model", "")
     mtype = get(model, "type", "model")
@@ -447,6 +481,8 @@ def build_scenario(raw):
     info_command = as_bool(info.get("command", False), "controller.leader_information.command")
     info_estimator = as_bool(info.get("estimator", False),
                              "controller.leader_information.estimator")
+    info_disturbance = as_bool(info.get("disturbance", False),
+                               "controller.leader_information.disturbance")
 
     leader = get(raw, "leader", "")
     x1_0 = as_vector(get(leader, "initial_state", "leader"), "leader.initial_state", n)
@@ -478,6 +514,7 @@ def build_scenario(raw):
                     control_rate=control_rate, d=d, alpha=alpha, epsilon=epsilon,
                     G=G, L=L, Q=Q, initial_estimate=init, tracker=tracker, Ge=Ge, S21=S21,
                     info_command=info_command, info_estimator=info_estimator,
+                    info_disturbance=info_disturbance,
                     x1_0=x1_0, x2_0=x2_0, input_pulses=input_pulses, sinusoids=sinusoids,
                     disturbances=disturbances, duration=duration)
 
@@ -538,13 +575,14 @@ def closed_loop(sc, Z, u1, ud):
         ua = sc.Ge @ (y - yh) + sc.S21 @ yh
     else:
         ua = np.zeros((sc.m, Z.shape[1]))
-    uff = u1 if sc.info_command else np.zeros_like(u1)
+    a1 = u1 + sc.B_pinv @ ud if sc.info_disturbance else u1   # leader acceleration told
+    uff = a1 if sc.info_command else np.zeros_like(u1)
     ub = sc.G @ y
     u2 = ub + ua + uff
 
     h = sc.Ac @ xh - sc.B @ ua + sc.L @ (yh - y)
     if sc.info_estimator:
-        h = h + sc.B @ (u1 - uff)
+        h = h + sc.B @ (a1 - uff)
 
     xm2 = sc.xi_max ** 2
     f = ((1.0 + sc.epsilon) * np.sum(xh * xh, axis=0) - xm2) / (sc.epsilon * xm2)

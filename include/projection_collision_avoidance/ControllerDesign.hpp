@@ -22,6 +22,7 @@ struct ControllerDesign {
   Eigen::MatrixXd gamma_inverse;         ///< Gamma^-1
   double lyapunov_residual = 0.0;        ///< ||Gamma F + F^T Gamma + Q||_F / ||Q||_F
   Eigen::MatrixXd output_pseudoinverse;  ///< pinv(C), n x p, for the initial estimate
+  Eigen::MatrixXd input_pseudoinverse;   ///< pinv(B), m x n: the acceleration part of u_d
   Eigen::MatrixXd fallback_gain;         ///< K_f, m x n (parameters.fallback_gain or its default)
   Eigen::MatrixXd fallback_matrix;       ///< A - B K_f: the predicted xi' in the fallback
   /// Decay rate mu = lambda_min(Q) / (2 lambda_max(Gamma)) of Theorem 3.1: ||e(t)|| <=
@@ -35,6 +36,14 @@ struct ControllerDesign {
   /// A_c + L C, A_c - B G_e C Hurwitz (the message lists the eigenvalues), K_f of size m x n,
   /// finite, with no eigenvalue of A - B K_f in the open right half-plane.
   static ControllerDesign create(const ControllerParameters& parameters);
+
+  /// The leader's acceleration as shared with the follower: a_1 = u_1 + pinv(B) u_d when
+  /// parameters.leader_disturbance_shared and u_d is known (@p disturbance non-empty), else u_1.
+  /// For a double integrator pinv(B) u_d is the velocity-rate part of u_d (m/s^2).
+  /// @param leader_input u_1 (m entries, m/s^2)
+  /// @param disturbance u_d (n entries: m/s, then m/s^2), or empty when unknown
+  Eigen::VectorXd leaderAcceleration(const Eigen::VectorXd& leader_input,
+                                     const Eigen::VectorXd& disturbance) const;
 };
 
 }  // namespace projection_collision_avoidance

@@ -33,6 +33,11 @@ struct ControllerParameters {
   Eigen::MatrixXd reference_gain;          ///< S_21, m x p (19)
   bool leader_input_in_command = false;    ///< add the leader's input u_1 to the command
   bool leader_input_in_estimator = false;  ///< model B (u_1 - u_ff) in the estimator drift
+  /// The leader acceleration shared into the command and the estimator includes the acceleration
+  /// part of the leader's disturbance, pinv(B) u_d, when the leader knows u_d: a_1 = u_1 +
+  /// pinv(B) u_d. The rest of u_d, (I - B pinv(B)) u_d (the position-rate part of a double
+  /// integrator's), is outside the range of B: no input can cancel it.
+  bool leader_disturbance_shared = false;
   /// Bound on the command's norm ||u_2|| (m/s^2 for double integrators); a larger command is
   /// scaled onto it. Infinity: no bound.
   double acceleration_limit = std::numeric_limits<double>::infinity();

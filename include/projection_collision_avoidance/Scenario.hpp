@@ -3,6 +3,7 @@
 #include <Eigen/Core>
 
 #include "projection_collision_avoidance/ControllerParameters.hpp"
+#include "projection_collision_avoidance/Formation.hpp"
 #include "projection_collision_avoidance/SignalProfile.hpp"
 
 namespace projection_collision_avoidance {
@@ -17,9 +18,11 @@ struct Scenario {
   SignalProfile leader_input;              ///< u_1(t), m; sampled at each control tick
   SignalProfile disturbance;               ///< u_d(t), n; x_1' = A x_1 + B u_1 + u_d
   double duration = 0.0;                   ///< s
+  FormationSpec formation;                 ///< the followers; one ("follower") by default
 
   /// Checks the parts that ControllerDesign::create() does not: initial states, signals and
-  /// duration. Throws ParameterError naming "leader.*", "follower.*" or "simulation.duration".
+  /// duration and formation. Throws ParameterError naming "leader.*", "follower.*",
+  /// "simulation.duration" or "formation.*".
   void validate() const;
 };
 

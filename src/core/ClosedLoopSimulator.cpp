@@ -2,125 +2,185 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <limits>
 #include <locale>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "projection_collision_avoidance/AgentIntegrator.hpp"
 #include "projection_collision_avoidance/ControllerDesign.hpp"
 #include "projection_collision_avoidance/DimensionDispatch.hpp"
 #include "projection_collision_avoidance/FollowerController.hpp"
+#include "projection_collision_avoidance/ParameterError.hpp"
 
 namespace projection_collision_avoidance {
 namespace {
 
-/// Both agents of the run, each integrated exactly with its input held over each period; the
-/// leader also under the disturbance u_d (applied exactly, the period split at its pulse edges).
+/// ||p_a - p_b|| over the first k (position) entries.
+template <typename Vector>
+double positionDistance(const Vector& a, const Vector& b, int k) {
+  double squared = 0.0;
+  for (int i = 0; i < k; ++i) {
+    const double delta = a(i) - b(i);
+    squared += delta * delta;
+  }
+  return std::sqrt(squared);
+}
+
+/// One follower of the run: its controller, its plant and its figures.
 template <typename Dims>
-class TwoAgentPlant {
- public:
-  using StateVector = typename Dims::StateVector;
-  using InputVector = typename Dims::InputVector;
-
-  TwoAgentPlant(const Scenario& scenario, double period)
-      : leader_(scenario.controller.model, period, scenario.leader_initial_state,
-                scenario.disturbance),
-        follower_(scenario.controller.model, period, scenario.follower_initial_state) {}
-
-  const StateVector& leader() const { return leader_.state(); }
-  const StateVector& follower() const { return follower_.state(); }
-
-  /// Integrates both agents from t to t + period with u_1, u_2 held and u_d exact.
-  void advance(double t, const InputVector& leader_input, const InputVector& follower_input) {
-    leader_.advance(t, leader_input);
-    follower_.advance(t, follower_input);
+struct SimulatedFollower {
+  SimulatedFollower(const FormationMember& formation_member, const ControllerDesign& member_design,
+                    const AgentModel& model)
+      : member(formation_member),
+        design(member_design),
+        controller(member_design),
+        plant(model, member_design.period, formation_member.initial_state),
+        separation(formation_member.separation),
+        command(Dims::InputVector::Zero(model.inputDimension())) {
+    summary.xi_max = design.xi_max;
+    summary.perimeter = design.perimeter;
+    summary.min_separation = std::numeric_limits<double>::infinity();
   }
 
- private:
-  AgentIntegrator<Dims> leader_;
-  AgentIntegrator<Dims> follower_;
+  FormationMember member;
+  ControllerDesign design;
+  FollowerController<Dims> controller;
+  AgentIntegrator<Dims> plant;
+  typename Dims::StateVector separation;  // d_i
+  typename Dims::InputVector command;     // u_i at the current tick
+  SimulationSummary summary;
 };
 
 template <typename Dims>
-SimulationSummary runClosedLoop(const Scenario& scenario, const ControllerDesign& design,
-                                const SampleObserver& observer) {
+FormationSummary runFormation(const Scenario& scenario, const ControllerDesign& scenario_design,
+                              const FormationObserver& observer) {
   using StateVector = typename Dims::StateVector;
   using InputVector = typename Dims::InputVector;
   using OutputVector = typename Dims::OutputVector;
-  const ControllerParameters& p = design.parameters;
+  const ControllerParameters& p = scenario_design.parameters;
   const AgentModel& model = p.model;
   const Eigen::Index m = model.inputDimension();
   const Eigen::Index n = model.stateDimension();
   const int k = model.position_dimension;
   const bool share_leader_input = p.leader_input_in_command || p.leader_input_in_estimator;
-
-  FollowerController<Dims> controller(design);
-  TwoAgentPlant<Dims> plant(scenario, design.period);
-  const StateVector separation = p.separation;
   const typename Dims::OutputMatrix output_matrix = model.C;
 
-  SimulationSummary summary;
-  summary.xi_max = design.xi_max;
-  summary.perimeter = design.perimeter;
-  summary.min_separation = std::numeric_limits<double>::infinity();
+  const std::vector<FormationMember> members =
+      layoutFormation(scenario.formation, p.separation, scenario.leader_initial_state,
+                      scenario.follower_initial_state);
+  std::vector<SimulatedFollower<Dims>> followers;
+  followers.reserve(members.size());
+  for (const FormationMember& member : members) {
+    followers.emplace_back(member, ControllerDesign::create(memberParameters(p, member)), model);
+  }
+  AgentIntegrator<Dims> leader(model, scenario_design.period, scenario.leader_initial_state,
+                               scenario.disturbance);
+  const StateVector zero_disturbance = StateVector::Zero(n);
+  const bool share_disturbance = share_leader_input && p.leader_disturbance_shared;
+  const bool need_disturbance = share_disturbance || static_cast<bool>(observer);
+  const typename Dims::StateGainMatrix input_pseudoinverse = scenario_design.input_pseudoinverse;
+
+  FormationSummary formation;
+  formation.min_pair_separation = std::numeric_limits<double>::infinity();
   const long last_tick = std::lround(scenario.duration * p.control_rate);
   for (long tick = 0; tick <= last_tick; ++tick) {
     const double t = static_cast<double>(tick) / p.control_rate;
-    const StateVector xi = plant.leader() - plant.follower() - separation;
-    const OutputVector y = output_matrix * xi;
     const InputVector leader_input = scenario.leader_input.value(t, m);
-    const auto& status = share_leader_input ? controller.step(y, leader_input) : controller.step(y);
-
-    const double xi_norm = xi.norm();
-    const StateVector offset = plant.leader() - plant.follower();
-    double separation_squared = 0.0;  // ||p_1 - p_2||^2 over the k position entries
-    for (int i = 0; i < k; ++i) {
-      separation_squared += offset(i) * offset(i);
+    const StateVector disturbance =
+        need_disturbance ? StateVector(scenario.disturbance.value(t, n)) : zero_disturbance;
+    InputVector leader_acceleration = leader_input;  // a_1 = u_1 (+ pinv(B) u_d)
+    if (share_disturbance) {
+      leader_acceleration += input_pseudoinverse * disturbance;
     }
-    const double separation_distance = std::sqrt(separation_squared);
-    summary.max_xi = std::max(summary.max_xi, xi_norm);
-    summary.max_xi_hat = std::max(summary.max_xi_hat, status.estimate_norm);
-    summary.min_separation = std::min(summary.min_separation, separation_distance);
-    summary.max_boundary_correction =
-        std::max(summary.max_boundary_correction, status.boundary_correction);
-    if (xi_norm > design.xi_max) {
-      summary.time_outside += design.period;
-    }
-    ++summary.ticks;
+    for (SimulatedFollower<Dims>& follower : followers) {
+      const bool behind_leader = follower.member.target == 0;
+      const SimulatedFollower<Dims>* ahead =
+          behind_leader ? nullptr
+                        : &followers[static_cast<std::size_t>(follower.member.target - 1)];
+      const StateVector& target_state = behind_leader ? leader.state() : ahead->plant.state();
+      const InputVector& target_acceleration = behind_leader ? leader_acceleration : ahead->command;
+      const StateVector xi = target_state - follower.plant.state() - follower.separation;
+      const OutputVector y = output_matrix * xi;
+      const auto& status = share_leader_input ? follower.controller.step(y, target_acceleration)
+                                              : follower.controller.step(y);
+      follower.command = status.command;
 
-    if (observer) {
-      SimulationSample sample;
-      sample.time = t;
-      sample.relative_error = xi;
-      sample.estimate = status.estimate;
-      sample.constraint_value = status.constraint_value;
-      sample.projection_active = status.projection_active;
-      sample.leader_state = plant.leader();
-      sample.follower_state = plant.follower();
-      sample.separation = separation_distance;
-      sample.command = status.command;
-      sample.baseline_command = status.baseline_command;
-      sample.tracker_command = status.tracker_command;
-      sample.leader_input = leader_input;
-      sample.disturbance = scenario.disturbance.value(t, n);
-      observer(sample);
+      SimulationSummary& summary = follower.summary;
+      const double xi_norm = xi.norm();
+      const double separation = positionDistance(target_state, follower.plant.state(), k);
+      summary.max_xi = std::max(summary.max_xi, xi_norm);
+      summary.max_xi_hat = std::max(summary.max_xi_hat, status.estimate_norm);
+      summary.min_separation = std::min(summary.min_separation, separation);
+      summary.max_boundary_correction =
+          std::max(summary.max_boundary_correction, status.boundary_correction);
+      if (xi_norm > follower.design.xi_max) {
+        summary.time_outside += follower.design.period;
+      }
+      ++summary.ticks;
+
+      if (observer) {
+        SimulationSample sample;
+        sample.time = t;
+        sample.relative_error = xi;
+        sample.estimate = status.estimate;
+        sample.constraint_value = status.constraint_value;
+        sample.projection_active = status.projection_active;
+        sample.leader_state = target_state;
+        sample.follower_state = follower.plant.state();
+        sample.separation = separation;
+        sample.command = status.command;
+        sample.baseline_command = status.baseline_command;
+        sample.tracker_command = status.tracker_command;
+        sample.leader_input = behind_leader ? leader_input : ahead->command;
+        sample.disturbance = behind_leader ? disturbance : zero_disturbance;
+        observer(follower.member.index - 1, sample);
+      }
+    }
+    for (std::size_t a = 0; a < followers.size(); ++a) {
+      const StateVector& x_a = followers[a].plant.state();
+      formation.min_pair_separation =
+          std::min(formation.min_pair_separation, positionDistance(x_a, leader.state(), k));
+      for (std::size_t b = a + 1; b < followers.size(); ++b) {
+        formation.min_pair_separation = std::min(
+            formation.min_pair_separation, positionDistance(x_a, followers[b].plant.state(), k));
+      }
     }
     if (tick < last_tick) {
-      plant.advance(t, leader_input, status.command);
+      leader.advance(t, leader_input);
+      for (SimulatedFollower<Dims>& follower : followers) {
+        follower.plant.advance(t, follower.command);
+      }
     }
   }
-  return summary;
+  for (const SimulatedFollower<Dims>& follower : followers) {
+    formation.followers.push_back(follower.summary);
+  }
+  return formation;
 }
 
 }  // namespace
 
-SimulationSummary simulate(const Scenario& scenario, const SampleObserver& observer) {
+FormationSummary simulateFormation(const Scenario& scenario, const FormationObserver& observer) {
   const ControllerDesign design = ControllerDesign::create(scenario.controller);
   scenario.validate();
   return visitDimensions(scenario.controller.model, [&](auto dims) {
-    return runClosedLoop<decltype(dims)>(scenario, design, observer);
+    return runFormation<decltype(dims)>(scenario, design, observer);
   });
+}
+
+SimulationSummary simulate(const Scenario& scenario, const SampleObserver& observer) {
+  if (scenario.formation.followers != 1) {
+    throw ParameterError("formation.followers",
+                         "simulate() runs one follower; use simulateFormation()");
+  }
+  FormationObserver forward;
+  if (observer) {
+    forward = [&observer](int /*member*/, const SimulationSample& sample) { observer(sample); };
+  }
+  return simulateFormation(scenario, forward).followers.front();
 }
 
 std::string formatSummary(const SimulationSummary& summary, double wall_seconds) {

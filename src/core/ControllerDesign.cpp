@@ -180,12 +180,25 @@ ControllerDesign ControllerDesign::create(const ControllerParameters& parameters
   }
 
   design.output_pseudoinverse = C.completeOrthogonalDecomposition().pseudoInverse();
+  design.input_pseudoinverse = B.completeOrthogonalDecomposition().pseudoInverse();
+  if (p.leader_disturbance_shared && !p.leader_input_in_command && !p.leader_input_in_estimator) {
+    throw ParameterError("controller.leader_information.disturbance",
+                         "shares nothing unless leader_information.command or .estimator is true");
+  }
   design.period = 1.0 / p.control_rate;
   const double d_norm = p.separation.norm();
   design.xi_max = (1.0 - p.alpha) * d_norm;
   design.xi_soft = design.xi_max / std::sqrt(1.0 + p.epsilon);
   design.perimeter = p.alpha * d_norm;
   return design;
+}
+
+Eigen::VectorXd ControllerDesign::leaderAcceleration(const Eigen::VectorXd& leader_input,
+                                                     const Eigen::VectorXd& disturbance) const {
+  if (parameters.leader_disturbance_shared && disturbance.size() > 0) {
+    return leader_input + input_pseudoinverse * disturbance;
+  }
+  return leader_input;
 }
 
 }  // namespace projection_collision_avoidance

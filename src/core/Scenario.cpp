@@ -18,6 +18,7 @@ void Scenario::validate() const {
   if (duration <= 0.0) {
     throw ParameterError("simulation.duration", "must be positive (s)");
   }
+  formation.validate(model);
 }
 
 }  // namespace projection_collision_avoidance

@@ -16,8 +16,24 @@
 namespace projection_collision_avoidance {
 namespace {
 
-FollowerNodeOptions readOptions(NodeOptionReader& reader, const ControllerParameters& p) {
+/// Member ~formation_index of the scenario's formation.
+FormationMember memberOf(NodeOptionReader& reader, const Scenario& scenario) {
+  const int index = reader.integer("formation_index", 1, 1, FormationSpec::kMaxFollowers);
+  if (index > scenario.formation.followers) {
+    throw ParameterError("~formation_index",
+                         "is " + std::to_string(index) + " but the formation has " +
+                             std::to_string(scenario.formation.followers) + " follower(s)");
+  }
+  const std::vector<FormationMember> members =
+      layoutFormation(scenario.formation, scenario.controller.separation,
+                      scenario.leader_initial_state, scenario.follower_initial_state);
+  return members[static_cast<std::size_t>(index - 1)];
+}
+
+FollowerNodeOptions readOptions(NodeOptionReader& reader, const ControllerParameters& p,
+                                const FormationMember& member) {
   FollowerNodeOptions options;
+  options.formation_index = member.index;
   const double period = 1.0 / p.control_rate;
   options.measurement_timeout =
       reader.number("measurement_timeout", options.measurement_timeout, period, 3600.0);
@@ -27,7 +43,7 @@ FollowerNodeOptions readOptions(NodeOptionReader& reader, const ControllerParame
   options.use_leader_broadcast = reader.boolean("use_leader_broadcast", false);
   options.measurement_frame = reader.text("measurement_frame", "");
   options.leader_broadcast_frame = reader.text("leader_broadcast_frame", "");
-  options.follower_frame = reader.text("follower_frame", options.follower_frame);
+  options.follower_frame = reader.text("follower_frame", member.name);
   if (options.follower_frame.empty()) {
     throw ParameterError("~follower_frame", "must not be empty");
   }
@@ -38,17 +54,22 @@ FollowerNodeOptions readOptions(NodeOptionReader& reader, const ControllerParame
 }  // namespace
 
 FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
+    : FollowerNode(nh, private_nh, loadDoubleIntegratorScenario(private_nh)) {}
+
+FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh, const Scenario& scenario)
     : nh_(nh),
       private_nh_(private_nh),
-      parameters_(loadDoubleIntegratorScenario(private_nh).controller),
+      reader_(private_nh),
+      member_(memberOf(reader_, scenario)),
+      parameters_(memberParameters(scenario.controller, member_)),
       controller_(ControllerDesign::create(parameters_)),
       axes_(parameters_.model.double_integrator_axes),
       measurement_guard_("relative_measurement", "", 0.0),
       leader_guard_("leader_broadcast", "", 0.0),
       diagnostics_(nh, private_nh),
       reconfigure_server_(reconfigure_mutex_, private_nh) {
-  NodeOptionReader reader(private_nh);
-  options_ = readOptions(reader, parameters_);
+  NodeOptionReader& reader = reader_;
+  options_ = readOptions(reader, parameters_, member_);
   measurement_guard_ =
       InputGuard("relative_measurement", options_.measurement_frame, options_.max_future_stamp);
   leader_guard_ =
@@ -60,6 +81,7 @@ FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   relative_state_ = Eigen::VectorXd::Zero(2 * axes_);
   leader_input_ = Eigen::VectorXd::Zero(axes_);
   command_publisher_ = nh_.advertise<geometry_msgs::AccelStamped>("command", 10);
+  broadcast_publisher_ = nh_.advertise<LeaderBroadcast>("broadcast", 10);
   status_publisher_ = nh_.advertise<FollowerStatus>("status", 10);
   marker_publisher_ = nh_.advertise<visualization_msgs::MarkerArray>("markers", 2);
   measurement_subscriber_ = nh_.subscribe("relative_measurement", 10, &FollowerNode::onMeasurement,
@@ -80,8 +102,10 @@ FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   timer_ = nh_.createTimer(timer_options);
   control_spinner_ = std::make_unique<ros::AsyncSpinner>(1, &control_queue_);
   control_spinner_->start();
-  ROS_INFO_STREAM(name << ": running at " << parameters_.control_rate << " Hz, " << axes_
-                       << " axes, xi_max " << controller_.design().xi_max << " m");
+  ROS_INFO_STREAM(name << ": " << member_.name << " looking at " << member_.target_name << ", d = ["
+                       << parameters_.separation.transpose() << "], running at "
+                       << parameters_.control_rate << " Hz, " << axes_ << " axes, xi_max "
+                       << controller_.design().xi_max << " m");
 }
 
 FollowerNode::~FollowerNode() {
@@ -111,11 +135,12 @@ void FollowerNode::onLeaderBroadcast(const LeaderBroadcast::ConstPtr& msg) {
   }
   std::string why;
   Eigen::VectorXd input;
-  if (!leaderInputFromMsg(*msg, axes_, &input, &why)) {
+  Eigen::VectorXd disturbance;
+  if (!leaderInputFromMsg(*msg, axes_, &input, &disturbance, &why)) {
     leader_guard_.reject(why);
     return;
   }
-  leader_input_ = input;
+  leader_input_ = controller_.design().leaderAcceleration(input, disturbance);
   leader_guard_.accept(msg->header.stamp);
 }
 
@@ -170,6 +195,11 @@ void FollowerNode::onControlTick(const ros::TimerEvent& /*event*/) {
     status = use_leader_input ? &controller_.step(y, leader_input_) : &controller_.step(y);
   }
   command_publisher_.publish(toAccelMsg(status->command, now, options_.follower_frame));
+  LeaderBroadcast broadcast;  // for a follower behind this one: its acceleration, no state
+  broadcast.header.stamp = now;
+  broadcast.header.frame_id = options_.follower_frame;
+  broadcast.input = toStdVector(status->command);
+  broadcast_publisher_.publish(broadcast);
   last_xi_norm_ = xi.norm();
   publishStatus(now, xi, ages.measurement_age);
   const long ticks_per_marker =
@@ -190,6 +220,8 @@ void FollowerNode::publishStatus(const ros::Time& now, const Eigen::VectorXd& xi
   FollowerStatus msg;
   msg.header.stamp = now;
   msg.header.frame_id = options_.follower_frame;
+  msg.formation_index = static_cast<uint32_t>(member_.index);
+  msg.target = member_.target_name;
   msg.mode = static_cast<uint8_t>(mode_);
   msg.mode_name = toString(mode_);
   msg.fallback = s.fallback;
@@ -230,9 +262,10 @@ void FollowerNode::publishMarkers(const ros::Time& now, const Eigen::VectorXd& x
   visualization_msgs::MarkerArray markers;
   // Safety perimeter alpha ||d|| around the follower: green, red once the leader is inside.
   // A flat disc on the ground plane (a sphere in 3-D), so the markers above it stay visible.
-  visualization_msgs::Marker perimeter = toMarker(
-      frame, now, "perimeter", 0, Marker::SPHERE, Eigen::Vector3d::Zero(), 2.0 * design.perimeter,
-      {inside_perimeter ? 1.0F : 0.1F, inside_perimeter ? 0.1F : 0.8F, 0.1F, 0.35F});
+  visualization_msgs::Marker perimeter =
+      toMarker(frame, now, "perimeter", member_.index, Marker::SPHERE, Eigen::Vector3d::Zero(),
+               2.0 * design.perimeter,
+               {inside_perimeter ? 1.0F : 0.1F, inside_perimeter ? 0.1F : 0.8F, 0.1F, 0.35F});
   if (axes_ < 3) {
     perimeter.type = Marker::CYLINDER;
     perimeter.scale.z = 0.02;
@@ -240,8 +273,8 @@ void FollowerNode::publishMarkers(const ros::Time& now, const Eigen::VectorXd& x
   markers.markers.push_back(perimeter);
   // The slot x_1 - d, relative to the follower: (p_1 - p_2) - d_p.
   const Eigen::VectorXd slot = relative_state_.head(axes_) - parameters_.separation.head(axes_);
-  visualization_msgs::Marker slot_marker =
-      toMarker(frame, now, "slot", 0, Marker::CUBE, toVector3(slot), 0.3, {0.8F, 0.8F, 0.8F, 0.9F});
+  visualization_msgs::Marker slot_marker = toMarker(frame, now, "slot", member_.index, Marker::CUBE,
+                                                    toVector3(slot), 0.3, {0.8F, 0.8F, 0.8F, 0.9F});
   markers.markers.push_back(slot_marker);
   // The follower where the CF estimate puts it: p_2 + (xi - xi_hat)_p. Grey in the fallback,
   // where xi is the last measured one and xi_hat a prediction.
@@ -249,13 +282,13 @@ void FollowerNode::publishMarkers(const ros::Time& now, const Eigen::VectorXd& x
   const Eigen::VectorXd ghost = (xi - s.estimate).head(axes_);
   const MarkerColor ghost_color =
       fallback ? MarkerColor{0.5F, 0.5F, 0.5F, 0.45F} : MarkerColor{1.0F, 0.55F, 0.0F, 0.45F};
-  markers.markers.push_back(
-      toMarker(frame, now, "cf_estimate", 0, Marker::SPHERE, toVector3(ghost), 0.5, ghost_color));
+  markers.markers.push_back(toMarker(frame, now, "cf_estimate", member_.index, Marker::SPHERE,
+                                     toVector3(ghost), 0.5, ghost_color));
   // ||xi|| against xi_max, as text above the follower; the mode unless tracking.
   const float shade = xi.norm() > design.xi_max || fallback ? 0.2F : 1.0F;  // red: trouble
   visualization_msgs::Marker text =
-      toMarker(frame, now, "bound", 0, Marker::TEXT_VIEW_FACING, Eigen::Vector3d(0.0, 0.0, 1.2),
-               0.35, {1.0F, shade, shade, 1.0F});
+      toMarker(frame, now, "bound", member_.index, Marker::TEXT_VIEW_FACING,
+               Eigen::Vector3d(0.0, 0.0, 1.2), 0.35, {1.0F, shade, shade, 1.0F});
   std::ostringstream label;
   label << std::fixed << std::setprecision(2) << "|xi| " << xi.norm() << " / xi_max "
         << design.xi_max << " m";

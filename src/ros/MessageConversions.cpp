@@ -41,16 +41,18 @@ bool relativeStateFromMsg(const RelativeMeasurement& msg, int axes, Eigen::Vecto
 }
 
 bool leaderInputFromMsg(const LeaderBroadcast& msg, int axes, Eigen::VectorXd* input,
-                        std::string* why) {
+                        Eigen::VectorXd* disturbance, std::string* why) {
   const auto size = [](const std::vector<double>& field) { return std::to_string(field.size()); };
   const auto axes_entries = static_cast<std::size_t>(axes);
-  if (msg.position.size() != axes_entries || msg.velocity.size() != axes_entries ||
-      msg.input.size() != axes_entries ||
+  const bool state_known =
+      msg.position.size() == axes_entries && msg.velocity.size() == axes_entries;
+  const bool state_unknown = msg.position.empty() && msg.velocity.empty();
+  if (!(state_known || state_unknown) || msg.input.size() != axes_entries ||
       (!msg.disturbance.empty() && msg.disturbance.size() != 2 * axes_entries)) {
-    *why = "position, velocity and input must have " + std::to_string(axes) +
-           " entries and disturbance 0 or " + std::to_string(2 * axes) + ", got " +
-           size(msg.position) + ", " + size(msg.velocity) + ", " + size(msg.input) + " and " +
-           size(msg.disturbance);
+    *why = "input must have " + std::to_string(axes) + " entries, position and velocity " +
+           std::to_string(axes) + " each or none, and disturbance 0 or " +
+           std::to_string(2 * axes) + ", got " + size(msg.position) + ", " + size(msg.velocity) +
+           ", " + size(msg.input) + " and " + size(msg.disturbance);
     return false;
   }
   for (const std::vector<double>* field :
@@ -61,6 +63,7 @@ bool leaderInputFromMsg(const LeaderBroadcast& msg, int axes, Eigen::VectorXd* i
     }
   }
   *input = toEigen(msg.input);
+  *disturbance = toEigen(msg.disturbance);
   return true;
 }
 

@@ -9,8 +9,10 @@
 #include <geometry_msgs/TransformStamped.h>
 #include <nav_msgs/Odometry.h>
 #include <rosgraph_msgs/Clock.h>
+#include <tf2_eigen/tf2_eigen.h>
 #include <visualization_msgs/MarkerArray.h>
 
+#include "projection_collision_avoidance/Formation.hpp"
 #include "projection_collision_avoidance/ParameterError.hpp"
 #include "projection_collision_avoidance/ros/MessageConversions.hpp"
 
@@ -109,14 +111,29 @@ PlantNode::PlantNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   echoScenario(name_, private_nh);
   reader_.echo(name_);
 
-  // The follower list: one follower for now. Subscriptions hold pointers into it, so it is
-  // complete before any is made.
-  followers_.push_back(Follower{
-      Agent("follower", options_.follower_frame, scenario_.controller.model, 1.0 / options_.rate,
-            scenario_.follower_initial_state, SignalProfile{}, options_.command_timeout),
-      {},
-      {},
-      0});
+  // The followers of the formation. Subscriptions hold pointers into the list, so it is complete
+  // before any is made.
+  const std::vector<FormationMember> members =
+      layoutFormation(scenario_.formation, scenario_.controller.separation,
+                      scenario_.leader_initial_state, scenario_.follower_initial_state);
+  followers_.reserve(members.size());
+  for (const FormationMember& member : members) {
+    const std::string frame =
+        scenario_.formation.configured ? member.name : options_.follower_frame;
+    if (frame == options_.world_frame || frame == options_.leader_frame) {
+      throw ParameterError(
+          scenario_.formation.configured ? "~scenario/formation" : "~follower_frame",
+          "follower frame '" + frame + "' clashes with the world or leader frame");
+    }
+    followers_.push_back(
+        Follower{Agent(member.name, frame, scenario_.controller.model, 1.0 / options_.rate,
+                       member.initial_state, SignalProfile{}, options_.command_timeout),
+                 member.target,
+                 {},
+                 {},
+                 0,
+                 false});
+  }
   leader_.odom_publisher = nh_.advertise<nav_msgs::Odometry>("leader/odom", 10);
   leader_.applied_command_publisher =
       nh_.advertise<geometry_msgs::AccelStamped>("leader/applied_command", 10);
@@ -161,8 +178,12 @@ PlantNode::PlantNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
     timer_ = nh_.createTimer(ros::Duration(1.0 / options_.rate), &PlantNode::onRosTick, this);
   }
   std::ostringstream summary;
-  summary << name_ << ": simulating a leader and " << followers_.size() << " follower(s), " << axes_
-          << " axes, at " << options_.rate << " Hz";
+  summary << name_ << ": simulating a leader and " << followers_.size() << " follower(s)";
+  if (scenario_.formation.configured) {
+    summary << " (" << toString(scenario_.formation.topology) << ", "
+            << toString(scenario_.formation.shape) << ")";
+  }
+  summary << ", " << axes_ << " axes, at " << options_.rate << " Hz";
   if (options_.publish_clock) {
     summary << ", publishing /clock at " << options_.real_time_factor << "x real time";
   } else {
@@ -349,7 +370,7 @@ void PlantNode::publishMeasurement(Follower* follower, long k, const ros::Time& 
     ++follower->dropped;
   } else {
     const Eigen::VectorXd relative =
-        leader_.integrator.state() - follower->agent.integrator.state() + noise;
+        targetOf(*follower).integrator.state() - follower->agent.integrator.state() + noise;
     follower->pending.push_back(toRelativeMeasurementMsg(relative, stamp, options_.world_frame));
   }
   // Publish what was sampled at least `latency` ago (in ticks, t_k - t_j >= latency).
@@ -365,20 +386,32 @@ void PlantNode::publishMeasurement(Follower* follower, long k, const ros::Time& 
   }
 }
 
+const PlantNode::Agent& PlantNode::targetOf(const Follower& follower) const {
+  return follower.target == 0 ? leader_
+                              : followers_[static_cast<std::size_t>(follower.target - 1)].agent;
+}
+
 void PlantNode::publishMarkers(const ros::Time& stamp) {
   using visualization_msgs::Marker;
   visualization_msgs::MarkerArray markers;
   markers.markers.push_back(toMarker(leader_.frame, stamp, "agents", 0, Marker::CUBE,
                                      Eigen::Vector3d::Zero(), 0.6, {0.1F, 0.3F, 1.0F, 1.0F}));
   markers.markers.push_back(labelMarker(leader_.frame, stamp, 0, leader_.name, 0.7));
+  // Who looks at whom: a thin grey line from each follower to its target, in the world frame.
+  Marker links = toMarker(options_.world_frame, stamp, "links", 0, Marker::LINE_LIST,
+                          Eigen::Vector3d::Zero(), 0.04, {0.6F, 0.6F, 0.6F, 0.8F});
   int id = 1;
   for (const Follower& follower : followers_) {
     markers.markers.push_back(toMarker(follower.agent.frame, stamp, "agents", id, Marker::SPHERE,
                                        Eigen::Vector3d::Zero(), 0.5, {1.0F, 0.55F, 0.0F, 1.0F}));
     markers.markers.push_back(
         labelMarker(follower.agent.frame, stamp, id, follower.agent.name, 0.6));
+    for (const Agent* end : {&follower.agent, &targetOf(follower)}) {
+      links.points.push_back(tf2::toMsg(toVector3(end->integrator.state().head(axes_))));
+    }
     ++id;
   }
+  markers.markers.push_back(links);
   marker_publisher_.publish(markers);
 }
 

@@ -1,14 +1,20 @@
 #include "projection_collision_avoidance/CfSimApp.hpp"
 
 #include <chrono>
+#include <cmath>
 #include <cstddef>
+#include <exception>
+#include <filesystem>
 #include <fstream>
+#include <locale>
 #include <memory>
 #include <ostream>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include "projection_collision_avoidance/ClosedLoopSimulator.hpp"
+#include "projection_collision_avoidance/DisturbanceSweep.hpp"
 #include "projection_collision_avoidance/ParameterError.hpp"
 #include "projection_collision_avoidance/ScenarioLoader.hpp"
 #include "projection_collision_avoidance/SimulationCsvWriter.hpp"
@@ -16,27 +22,72 @@
 namespace projection_collision_avoidance {
 namespace {
 
-constexpr const char* kUsage = "usage: cf_sim SCENARIO.yaml [--set key=value]... [--csv FILE]";
+constexpr const char* kUsage =
+    "usage: cf_sim SCENARIO.yaml [--set key=value]... [--csv FILE]\n"
+    "       cf_sim SCENARIO.yaml [--set key=value]... --sweep FILE [--directions N]\n"
+    "              [--max-size S] [--size-step S] [--tolerance S]";
+
+constexpr double kDegreesPerRadian = 57.29577951308232;
 
 struct Options {
   std::string scenario_path;
   std::vector<std::string> overrides;
   std::string csv_path;
+  std::string sweep_path;
+  SweepOptions sweep;
 };
 
+/// Parses a number option's value; false (with a message) if it is not one.
+bool parseNumber(const std::string& option, const std::string& text, double* value,
+                 std::ostream& err) {
+  try {
+    std::size_t consumed = 0;
+    *value = std::stod(text, &consumed);
+    if (consumed == text.size() && std::isfinite(*value)) {
+      return true;
+    }
+  } catch (const std::exception&) {
+  }
+  err << "cf_sim: " << option << " needs a finite number, got '" << text << "'\n";
+  return false;
+}
+
 bool parseOptions(const std::vector<std::string>& arguments, Options* options, std::ostream& err) {
+  const std::vector<std::string> valued = {
+      "--set", "--csv", "--sweep", "--directions", "--max-size", "--size-step", "--tolerance"};
   for (std::size_t i = 0; i < arguments.size(); ++i) {
     const std::string& argument = arguments[i];
-    if (argument == "--set" || argument == "--csv") {
+    bool takes_value = false;
+    for (const std::string& name : valued) {
+      takes_value = takes_value || argument == name;
+    }
+    if (takes_value) {
       if (i + 1 >= arguments.size()) {
         err << "cf_sim: " << argument << " needs a value\n" << kUsage << "\n";
         return false;
       }
-      ++i;
+      const std::string& value = arguments[++i];
+      double number = 0.0;
       if (argument == "--set") {
-        options->overrides.push_back(arguments[i]);
+        options->overrides.push_back(value);
+      } else if (argument == "--csv") {
+        options->csv_path = value;
+      } else if (argument == "--sweep") {
+        options->sweep_path = value;
+      } else if (!parseNumber(argument, value, &number, err)) {
+        return false;
+      } else if (argument == "--directions") {
+        if (number != std::trunc(number) || std::abs(number) > 1e6) {
+          err << "cf_sim: --directions needs a whole number, got '" << value << "'\n";
+          return false;
+        }
+        options->sweep.directions = static_cast<int>(number);
+      } else if (argument == "--max-size") {
+        options->sweep.max_size = number;
+      } else if (argument == "--size-step") {
+        options->sweep.size_step = number;
       } else {
-        options->csv_path = arguments[i];
+        options->sweep.tolerance = number;
       }
     } else if (argument == "-h" || argument == "--help") {
       err << kUsage << "\n";
@@ -55,7 +106,113 @@ bool parseOptions(const std::vector<std::string>& arguments, Options* options, s
     err << kUsage << "\n";
     return false;
   }
+  if (!options->sweep_path.empty() && !options->csv_path.empty()) {
+    err << "cf_sim: --sweep and --csv do not go together\n" << kUsage << "\n";
+    return false;
+  }
   return true;
+}
+
+/// FILE for one follower; FILE with "_<name>" before its extension in a formation.
+std::string csvPathOf(const std::string& path, const FormationMember& member, bool formation) {
+  if (!formation) {
+    return path;
+  }
+  const std::filesystem::path original(path);
+  std::filesystem::path result = original.parent_path();
+  result /= original.stem().string() + "_" + member.name + original.extension().string();
+  return result.string();
+}
+
+/// Runs the scenario's formation (one follower without a formation section), writing the CSVs.
+int runSimulation(const Scenario& scenario, const Options& options, std::ostream& out,
+                  std::ostream& err) {
+  const bool formation = scenario.formation.configured;
+  const std::vector<FormationMember> members =
+      layoutFormation(scenario.formation, scenario.controller.separation,
+                      scenario.leader_initial_state, scenario.follower_initial_state);
+  std::vector<std::string> csv_paths;
+  std::vector<std::unique_ptr<std::ofstream>> csv_files;
+  std::vector<std::unique_ptr<SimulationCsvWriter>> writers;
+  if (!options.csv_path.empty()) {
+    for (const FormationMember& member : members) {
+      csv_paths.push_back(csvPathOf(options.csv_path, member, formation));
+      csv_files.push_back(std::make_unique<std::ofstream>(csv_paths.back()));
+      if (!*csv_files.back()) {
+        err << "cf_sim: cannot write " << csv_paths.back() << "\n";
+        return 3;
+      }
+      Scenario member_scenario = scenario;
+      member_scenario.controller = memberParameters(scenario.controller, member);
+      writers.push_back(std::make_unique<SimulationCsvWriter>(*csv_files.back(), member_scenario));
+    }
+  }
+  FormationObserver observer;
+  if (!writers.empty()) {
+    observer = [&writers](int member, const SimulationSample& sample) {
+      writers[static_cast<std::size_t>(member)]->write(sample);
+    };
+  }
+  const auto start = std::chrono::steady_clock::now();
+  const FormationSummary summary = simulateFormation(scenario, observer);
+  const double wall =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  for (std::size_t i = 0; i < csv_files.size(); ++i) {
+    csv_files[i]->flush();
+    if (!*csv_files[i]) {
+      err << "cf_sim: error writing " << csv_paths[i] << "\n";
+      return 3;
+    }
+  }
+  if (!formation) {
+    out << formatSummary(summary.followers.front(), wall) << "\n";
+    return 0;
+  }
+  for (std::size_t i = 0; i < members.size(); ++i) {
+    out << members[i].name << " target=" << members[i].target_name << " "
+        << formatSummary(summary.followers[i], wall) << "\n";
+  }
+  std::ostringstream last;
+  last.imbue(std::locale::classic());
+  last.precision(9);
+  last << "formation followers=" << members.size()
+       << " topology=" << toString(scenario.formation.topology)
+       << " shape=" << toString(scenario.formation.shape)
+       << " min_pair_separation=" << summary.min_pair_separation << " wall_s=" << wall;
+  out << last.str() << "\n";
+  return 0;
+}
+
+/// Runs the disturbance sweep and writes its CSV.
+int runSweep(const Scenario& scenario, const Options& options, std::ostream& out,
+             std::ostream& err) {
+  std::ofstream file(options.sweep_path);
+  if (!file) {
+    err << "cf_sim: cannot write " << options.sweep_path << "\n";
+    return 3;
+  }
+  file.imbue(std::locale::classic());
+  file.precision(9);
+  file << "tracker,sharing,direction_deg,bound_limit,bound_capped,perimeter_limit,"
+          "perimeter_capped\n";
+  const auto start = std::chrono::steady_clock::now();
+  long points = 0;
+  sweepDisturbance(scenario, options.sweep, [&](const SweepPoint& point) {
+    file << (point.configuration.tracker ? "on" : "off") << ','
+         << toString(point.configuration.sharing) << ',' << point.direction * kDegreesPerRadian
+         << ',' << point.bound_limit << ',' << (point.bound_capped ? 1 : 0) << ','
+         << point.perimeter_limit << ',' << (point.perimeter_capped ? 1 : 0) << '\n';
+    ++points;
+  });
+  file.flush();
+  if (!file) {
+    err << "cf_sim: error writing " << options.sweep_path << "\n";
+    return 3;
+  }
+  const double wall =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  out << "sweep points=" << points << " wall_s=" << wall << "\n";
+  return 0;
 }
 
 }  // namespace
@@ -67,33 +224,10 @@ int runCfSim(const std::vector<std::string>& arguments, std::ostream& out, std::
   }
   try {
     const Scenario scenario = loadScenarioFile(options.scenario_path, options.overrides);
-    std::ofstream csv_file;
-    std::unique_ptr<SimulationCsvWriter> csv;
-    if (!options.csv_path.empty()) {
-      csv_file.open(options.csv_path);
-      if (!csv_file) {
-        err << "cf_sim: cannot write " << options.csv_path << "\n";
-        return 3;
-      }
-      csv = std::make_unique<SimulationCsvWriter>(csv_file, scenario);
+    if (!options.sweep_path.empty()) {
+      return runSweep(scenario, options, out, err);
     }
-    SampleObserver observer;
-    if (csv) {
-      observer = [&csv](const SimulationSample& sample) { csv->write(sample); };
-    }
-    const auto start = std::chrono::steady_clock::now();
-    const SimulationSummary summary = simulate(scenario, observer);
-    const double wall =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (csv) {
-      csv_file.flush();
-      if (!csv_file) {
-        err << "cf_sim: error writing " << options.csv_path << "\n";
-        return 3;
-      }
-    }
-    out << formatSummary(summary, wall) << "\n";
-    return 0;
+    return runSimulation(scenario, options, out, err);
   } catch (const ParameterError& error) {
     err << "cf_sim: invalid scenario: " << error.what() << "\n";
     return 1;

@@ -215,6 +215,9 @@ ControllerParameters readController(detail::YamlReader& reader, const AgentModel
     if (sharing.has("estimator")) {
       result.leader_input_in_estimator = sharing.boolean("estimator");
     }
+    if (sharing.has("disturbance")) {
+      result.leader_disturbance_shared = sharing.boolean("disturbance");
+    }
     sharing.finish();
   }
   controller.finish();
@@ -302,6 +305,24 @@ Scenario readScenario(const YAML::Node& root) {
   detail::YamlReader simulation = reader.map("simulation");
   scenario.duration = simulation.number("duration");
   simulation.finish();
+
+  if (reader.has("formation")) {
+    detail::YamlReader formation = reader.map("formation");
+    FormationSpec& spec = scenario.formation;
+    spec.configured = true;
+    spec.followers = formation.integer("followers");
+    if (formation.has("topology")) {
+      spec.topology =
+          parseFormationTopology(formation.string("topology"), formation.key("topology"));
+    }
+    if (formation.has("shape")) {
+      spec.shape = parseFormationShape(formation.string("shape"), formation.key("shape"));
+    }
+    if (formation.has("half_angle")) {
+      spec.half_angle = formation.number("half_angle");
+    }
+    formation.finish();
+  }
   reader.finish();
 
   ControllerDesign::create(scenario.controller);

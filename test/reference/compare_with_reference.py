@@ -83,6 +83,14 @@ def _rotated_2d(angle_deg):
 _LEADER_INPUT = ("leader.input={pulses: [{start: 5.0, end: 9.0, vector: [0.8]}], "
                  "sinusoids: [{amplitude: [0.6], frequency: 0.05, phase: 0.5}]}")
 
+def _sharing(command=False, estimator=False, disturbance=False):
+    """Override setting the whole controller.leader_information mapping."""
+    def yaml_bool(flag):
+        return "true" if flag else "false"
+    return (f"controller.leader_information={{command: {yaml_bool(command)}, "
+            f"estimator: {yaml_bool(estimator)}, disturbance: {yaml_bool(disturbance)}}}")
+
+
 # The overrides set whole mappings and spell matrices out in full, so that
 # they do not depend on how a tool treats a --set below a key that the file
 # lacks, or a plain number for a non-square matrix.
@@ -117,6 +125,24 @@ CASES = (
          note="leader input u_1 told to the estimator, not fed forward"),
     Case("leader_input_unshared", "paper_run2.yaml", (_LEADER_INPUT,),
          note="leader input u_1 unknown to the follower"),
+    Case("share_dist_command", "paper_run2.yaml",
+         (_sharing(command=True, disturbance=True),),
+         note="a_1 = u_1 + pinv(B) u_d fed forward: only the position-rate half moves xi"),
+    Case("share_dist_estimator", "paper_run2.yaml",
+         (_sharing(estimator=True, disturbance=True),),
+         note="a_1 = u_1 + pinv(B) u_d in the estimator's model of xi'"),
+    Case("share_dist_both", "paper_run2.yaml",
+         (_sharing(command=True, estimator=True, disturbance=True),),
+         note="a_1 fed forward and told to the estimator"),
+    Case("share_dist_pos_rate", "paper_run2.yaml",
+         (_sharing(command=True, disturbance=True), "leader.disturbance.0.vector=[-2.0, 0.0]"),
+         note="pure position-rate pulse: pinv(B) u_d = 0, nothing to feed forward"),
+    Case("share_dist_vel_rate", "paper_run2.yaml",
+         (_sharing(command=True, disturbance=True), "leader.disturbance.0.vector=[0.0, -2.0]"),
+         note="pure velocity-rate pulse fed forward: xi stays 0"),
+    Case("share_dist_rotated_2d", "paper_run2.yaml",
+         _rotated_2d(60.0) + (_sharing(command=True, disturbance=True),),
+         note="run 2 in 2-D rotated by 60 deg, a_1 with pinv(B) u_d fed forward"),
     Case("rotated_2d_run1", "paper_run1.yaml", _rotated_2d(30.0),
          note="run 1 in 2-D, every vector rotated by 30 deg"),
     Case("rotated_2d_run2", "paper_run2.yaml", _rotated_2d(-115.0),

@@ -4,6 +4,7 @@
 /// Fixture of the rostests: subscribes to what the follower publishes, and waits on conditions
 /// with wall-clock deadlines (never fixed sleeps).
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -35,6 +36,24 @@ struct StatusRecord {
   double last_time = 0.0;       ///< stamp of the latest status (s)
   FollowerStatus last;
 };
+
+/// Adds one status to a record.
+inline void addStatus(const FollowerStatus& msg, StatusRecord* record) {
+  ++record->count;
+  record->max_xi = std::max(record->max_xi, msg.xi_norm);
+  record->max_xi_hat = std::max(record->max_xi_hat, msg.xi_hat_norm);
+  record->min_separation = std::min(record->min_separation, msg.separation);
+  double squared = 0.0;
+  for (const double u : msg.command) {
+    record->commands_finite = record->commands_finite && std::isfinite(u);
+    squared += u * u;
+  }
+  record->max_command = std::max(record->max_command, std::sqrt(squared));
+  record->fallback_ticks += msg.fallback ? 1 : 0;
+  record->modes.insert(msg.mode);
+  record->last_time = msg.header.stamp.toSec();
+  record->last = msg;
+}
 
 class FollowerTest : public ::testing::Test {
  protected:
@@ -90,20 +109,7 @@ class FollowerTest : public ::testing::Test {
  private:
   void onStatus(const FollowerStatus::ConstPtr& msg) {
     const std::lock_guard<std::mutex> lock(mutex_);
-    ++record_.count;
-    record_.max_xi = std::max(record_.max_xi, msg->xi_norm);
-    record_.max_xi_hat = std::max(record_.max_xi_hat, msg->xi_hat_norm);
-    record_.min_separation = std::min(record_.min_separation, msg->separation);
-    double squared = 0.0;
-    for (const double u : msg->command) {
-      record_.commands_finite = record_.commands_finite && std::isfinite(u);
-      squared += u * u;
-    }
-    record_.max_command = std::max(record_.max_command, std::sqrt(squared));
-    record_.fallback_ticks += msg->fallback ? 1 : 0;
-    record_.modes.insert(msg->mode);
-    record_.last_time = msg->header.stamp.toSec();
-    record_.last = *msg;
+    addStatus(*msg, &record_);
   }
 
   void onMarkers(const visualization_msgs::MarkerArray::ConstPtr& msg) {

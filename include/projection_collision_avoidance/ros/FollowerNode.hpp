@@ -13,11 +13,13 @@
 
 #include "projection_collision_avoidance/FollowerConfig.h"
 #include "projection_collision_avoidance/FollowerMode.hpp"
+#include "projection_collision_avoidance/Formation.hpp"
 #include "projection_collision_avoidance/LeaderBroadcast.h"
 #include "projection_collision_avoidance/RelativeMeasurement.h"
 #include "projection_collision_avoidance/RuntimeFollowerController.hpp"
 #include "projection_collision_avoidance/Scenario.hpp"
 #include "projection_collision_avoidance/ros/InputGuard.hpp"
+#include "projection_collision_avoidance/ros/RosParameters.hpp"
 
 namespace projection_collision_avoidance {
 
@@ -29,18 +31,24 @@ struct FollowerNodeOptions {
   bool use_leader_broadcast = false;   ///< use u_1 from leader_broadcast (always monitored)
   std::string measurement_frame;       ///< required frame_id of measurements ("" = any)
   std::string leader_broadcast_frame;  ///< required frame_id of leader broadcasts ("" = any)
-  std::string follower_frame = "follower";  ///< frame of the command, status and markers
-  double marker_rate = 10.0;                ///< Hz
+  std::string follower_frame;  ///< frame of the command, status and markers (default: the name)
+  double marker_rate = 10.0;   ///< Hz
+  int formation_index = 1;     ///< i: which follower of the scenario's formation this is
 };
 
 /// ROS wrapper of RuntimeFollowerController: translates messages and time, nothing else.
 ///
-/// Subscribes `relative_measurement` (RelativeMeasurement, x_1 - x_2) and `leader_broadcast`
-/// (LeaderBroadcast: monitored always, its u_1 used with ~use_leader_broadcast). Every
-/// 1 / control_rate s (ROS time) it picks the mode from the inputs' ages (selectFollowerMode()):
-/// with a fresh measurement it runs the controller on y = C (x_1 - x_2 - d), with a stale one the
-/// braking fallback; then it publishes `command` (geometry_msgs/AccelStamped), `status`
-/// (FollowerStatus), `markers` (visualization_msgs/MarkerArray, in the follower's frame) and
+/// The follower is member ~formation_index of the scenario's formation (layoutFormation()): it
+/// keeps the separation d_i of its slot to its target (the leader, or the follower ahead of it in
+/// a chain). Subscribes `relative_measurement` (RelativeMeasurement, x_target - x_i) and
+/// `leader_broadcast` (LeaderBroadcast of the target: monitored always, its acceleration u_1, plus
+/// pinv(B) u_d with controller.leader_information.disturbance, used with ~use_leader_broadcast).
+/// Every 1 / control_rate s (ROS time) it picks the mode from the inputs' ages
+/// (selectFollowerMode()): with a fresh measurement it runs the controller on
+/// y = C (x_target - x_i - d_i), with a stale one the braking fallback; then it publishes
+/// `command` (geometry_msgs/AccelStamped), `broadcast` (LeaderBroadcast with that command as
+/// input and no state, for a follower behind it), `status` (FollowerStatus), `markers`
+/// (visualization_msgs/MarkerArray in the follower's frame, id = formation index) and
 /// diagnostics. Messages that are non-finite, of the wrong size, in the wrong frame, stamped in
 /// the future or before the last accepted one are refused and counted. dynamic_reconfigure
 /// changes the tracker switch, alpha, epsilon and the tracker gain; a set the controller design
@@ -64,9 +72,13 @@ class FollowerNode {
   FollowerConfig configOf(const ControllerParameters& parameters) const;
   void logModeChange(FollowerMode mode);
 
+  FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh, const Scenario& scenario);
+
   ros::NodeHandle nh_;
   ros::NodeHandle private_nh_;
+  NodeOptionReader reader_;  ///< the private options, read once
   FollowerNodeOptions options_;
+  FormationMember member_;           ///< this follower's place in the formation
   ControllerParameters parameters_;  ///< as currently in force (scenario + reconfigure)
   RuntimeFollowerController controller_;
   int axes_;
@@ -74,7 +86,7 @@ class FollowerNode {
   std::mutex mutex_;  ///< guards everything below against concurrent callbacks (nodelets)
   Eigen::VectorXd relative_state_;  ///< latest accepted x_1 - x_2
   InputGuard measurement_guard_;
-  Eigen::VectorXd leader_input_;  ///< u_1 of the latest accepted leader broadcast
+  Eigen::VectorXd leader_input_;  ///< a_1 of the latest accepted leader broadcast
   InputGuard leader_guard_;
   FollowerMode mode_ = FollowerMode::kWaiting;  ///< of the latest tick
   bool leader_fresh_ = false;                   ///< at the latest tick
@@ -84,6 +96,7 @@ class FollowerNode {
   ros::Subscriber measurement_subscriber_;
   ros::Subscriber leader_subscriber_;
   ros::Publisher command_publisher_;
+  ros::Publisher broadcast_publisher_;
   ros::Publisher status_publisher_;
   ros::Publisher marker_publisher_;
   ros::Timer timer_;

@@ -33,12 +33,14 @@ Eigen::Vector3d toVector3(const Eigen::Ref<const Eigen::VectorXd>& values);
 bool relativeStateFromMsg(const RelativeMeasurement& msg, int axes, Eigen::VectorXd* state,
                           std::string* why);
 
-/// The leader's input u_1 (@p axes entries) of a LeaderBroadcast, after checking the whole
-/// message: position, velocity and input with @p axes entries, the disturbance empty or with
-/// 2 axes entries, all finite.
+/// The leader's input u_1 (@p axes entries) and disturbance u_d (2 axes entries, or empty when
+/// the leader does not know it) of a LeaderBroadcast, after checking the whole message: input
+/// with @p axes entries; position and velocity both with @p axes entries or both empty (an agent
+/// that does not know its own state, such as a follower in a chain); the disturbance empty or
+/// with 2 axes entries; all finite.
 /// @return false, with the reason in @p why, otherwise
 bool leaderInputFromMsg(const LeaderBroadcast& msg, int axes, Eigen::VectorXd* input,
-                        std::string* why);
+                        Eigen::VectorXd* disturbance, std::string* why);
 
 /// A RelativeMeasurement of the relative state [position; velocity] (2 axes entries).
 RelativeMeasurement toRelativeMeasurementMsg(const Eigen::Ref<const Eigen::VectorXd>& state,

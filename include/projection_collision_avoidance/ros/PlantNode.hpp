@@ -38,21 +38,24 @@ struct PlantNodeOptions {
   double duration = 0.0;          ///< s of simulated time, then shut down; 0 = forever
 };
 
-/// The simulated world: the leader and its followers (one for now, kept as a list), double
-/// integrators integrated exactly by AgentIntegrator with the commands held between ticks and
-/// the leader's disturbance u_d applied exactly, as cf_sim does.
+/// The simulated world: the leader and its followers, double integrators integrated exactly by
+/// AgentIntegrator with the commands held between ticks and the leader's disturbance u_d applied
+/// exactly, as cf_sim does. The followers are the scenario's formation (layoutFormation()): one
+/// named `follower` (tf frame ~follower_frame) without a formation section, else `follower_<i>`
+/// (frame of the same name), i = 1 .. N, each measured relative to its target.
 ///
-/// Subscribes `leader/command` and `follower/command` (geometry_msgs/AccelStamped; each held
+/// Subscribes `leader/command` and `<follower>/command` (geometry_msgs/AccelStamped; each held
 /// until replaced, and taken as zero once older than command_timeout; a command that is
 /// non-finite, acts on an axis the model lacks, is not in the agent's frame, is stamped more
 /// than command_timeout ahead of the plant's time or before the last accepted one is rejected,
 /// counted and warned about once per kind). At each tick t_k = k / rate it publishes
-/// `leader/odom`, `follower/odom` (nav_msgs/Odometry), tf world -> leader and
-/// world -> follower, `follower/relative_measurement` (RelativeMeasurement of x_1 - x_2 with
-/// noise, dropout, latency and an optional outage), at most 20 Hz (of simulated time)
-/// `agent_markers` (visualization_msgs/MarkerArray) and, with publish_clock, /clock = t_k; then
-/// it integrates every agent to t_{k+1} and publishes the command it held over that step as
-/// `leader/applied_command` and `follower/applied_command`.
+/// `leader/odom`, `<follower>/odom` (nav_msgs/Odometry), tf world -> each agent's frame,
+/// `<follower>/relative_measurement` (RelativeMeasurement of x_target - x_i with noise, dropout,
+/// latency and an optional outage), at most 20 Hz (of simulated time) `agent_markers`
+/// (visualization_msgs/MarkerArray: agents, names, and a line from each follower to its target)
+/// and, with publish_clock, /clock = t_k; then it integrates every agent to t_{k+1} and publishes
+/// the command it held over that step as `leader/applied_command` and
+/// `<follower>/applied_command`.
 ///
 /// Time: with publish_clock the plant owns simulated time (stamps t_k from 0), ticking on a wall
 /// timer at rate * real_time_factor (catching up ticks that a late callback missed). Otherwise it
@@ -81,9 +84,10 @@ class PlantNode {
     ros::Publisher applied_command_publisher;  ///< the command integrated over each tick
   };
 
-  /// A follower: its agent, and its relative measurements waiting for their latency.
+  /// A follower: its agent, its target, and its relative measurements waiting for their latency.
   struct Follower {
     Agent agent;
+    int target = 0;  ///< 0: the leader; j: followers_[j - 1]
     ros::Publisher measurement_publisher;
     std::deque<RelativeMeasurement> pending;  ///< sampled, in time order, not yet published
     unsigned dropped = 0;                     ///< measurements dropped so far (not the outage)
@@ -100,6 +104,8 @@ class PlantNode {
   /// Publishes the command the agent's tick k at time t (s) integrates, and integrates it.
   void advanceAgent(Agent* agent, double t, const ros::Time& stamp);
   void publishMarkers(const ros::Time& stamp);
+  /// The agent a follower is measured against.
+  const Agent& targetOf(const Follower& follower) const;
   /// The held command, or zero when it is absent or older than command_timeout at @p now.
   GenericDimensions::InputVector commandAt(Agent* agent, const ros::Time& now);
   /// The stamp of tick k: origin + k / rate.
@@ -115,7 +121,7 @@ class PlantNode {
 
   std::mutex mutex_;  ///< guards everything below against concurrent callbacks (nodelets)
   Agent leader_;
-  std::vector<Follower> followers_;  ///< never resized after the subscriptions are made
+  std::vector<Follower> followers_;  ///< in index order; never resized after the subscriptions
   std::mt19937 rng_;
   std::normal_distribution<double> normal_{0.0, 1.0};
   std::uniform_real_distribution<double> uniform_{0.0, 1.0};

@@ -1,0 +1,176 @@
+/// rostest: a formation (formation.launch) through the ROS graph on simulated time, against
+/// cf_sim's figures (simulateFormation()) for the same scenario and formation. Parameters
+/// (<param>s of the test node):
+///   ~scenario        the scenario with its formation section, loaded as the nodes load it
+///   ~end_time        simulated seconds to observe
+///   ~tolerance       largest difference to cf_sim of each follower's max ||xi|| and min
+///                    separation (m)
+///   ~wall_deadline   wall seconds to wait for end_time
+/// Every follower must report its own place (formation index, target), keep ||xi_hat|| within
+/// its xi_max, and keep its target outside its perimeter by the plant's odometry.
+
+#include <cstddef>
+#include <limits>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <nav_msgs/Odometry.h>
+#include <ros/ros.h>
+
+#include "projection_collision_avoidance/ClosedLoopSimulator.hpp"
+#include "projection_collision_avoidance/ControllerDesign.hpp"
+#include "projection_collision_avoidance/Formation.hpp"
+#include "projection_collision_avoidance/ros/RosParameters.hpp"
+
+#include "test_common.h"
+
+namespace projection_collision_avoidance {
+namespace {
+
+/// What the test saw of one agent.
+struct AgentRecord {
+  std::string name;
+  int target = 0;                                  ///< index into the agents (0 the leader)
+  testing::StatusRecord status;                    ///< followers only
+  std::map<ros::Time, Eigen::VectorXd> positions;  ///< odometry positions by stamp
+};
+
+class FormationTest : public ::testing::Test {
+ protected:
+  FormationTest() : private_nh_("~") {
+    scenario_ = loadScenarioParameter(private_nh_);
+    members_ = layoutFormation(scenario_.formation, scenario_.controller.separation,
+                               scenario_.leader_initial_state, scenario_.follower_initial_state);
+    agents_.resize(members_.size() + 1);
+    agents_[0].name = "leader";
+    for (std::size_t i = 0; i < members_.size(); ++i) {
+      agents_[i + 1].name = members_[i].name;
+      agents_[i + 1].target = members_[i].target;
+    }
+    for (std::size_t a = 0; a < agents_.size(); ++a) {
+      subscribers_.push_back(nh_.subscribe<nav_msgs::Odometry>(
+          "/" + agents_[a].name + "/odom", 1000,
+          [this, a](const nav_msgs::Odometry::ConstPtr& msg) { onOdometry(a, *msg); }));
+      if (a > 0) {
+        subscribers_.push_back(
+            nh_.subscribe<FollowerStatus>("/" + agents_[a].name + "/status", 1000,
+                                          [this, a](const FollowerStatus::ConstPtr& msg) {
+                                            const std::lock_guard<std::mutex> lock(mutex_);
+                                            testing::addStatus(*msg, &agents_[a].status);
+                                          }));
+      }
+    }
+  }
+
+  double param(const std::string& key) {
+    double value = 0.0;
+    EXPECT_TRUE(private_nh_.getParam(key, value)) << "missing test parameter ~" << key;
+    return value;
+  }
+
+  /// Spins until every follower has a status stamped at or after @p sim_seconds.
+  bool waitForAll(double sim_seconds, double wall_seconds) {
+    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(wall_seconds);
+    while (ros::ok() && ros::WallTime::now() < deadline) {
+      ros::spinOnce();
+      {
+        const std::lock_guard<std::mutex> lock(mutex_);
+        bool all = true;
+        for (std::size_t a = 1; a < agents_.size(); ++a) {
+          all = all && agents_[a].status.last_time >= sim_seconds;
+        }
+        if (all) {
+          return true;
+        }
+      }
+      ros::WallDuration(0.002).sleep();
+    }
+    return false;
+  }
+
+  ros::NodeHandle nh_;
+  ros::NodeHandle private_nh_;
+  Scenario scenario_;
+  std::vector<FormationMember> members_;
+  std::mutex mutex_;
+
+  /// min ||p_target - p_i|| over the plant ticks at which both odometries arrived (m), and the
+  /// number of such ticks.
+  std::pair<double, int> trueMinSeparation(std::size_t a) const {
+    const AgentRecord& agent = agents_[a];
+    const AgentRecord& target = agents_[static_cast<std::size_t>(agent.target)];
+    double smallest = std::numeric_limits<double>::infinity();
+    int ticks = 0;
+    for (const auto& [stamp, position] : agent.positions) {
+      const auto match = target.positions.find(stamp);
+      if (match != target.positions.end()) {
+        smallest = std::min(smallest, (match->second - position).norm());
+        ++ticks;
+      }
+    }
+    return {smallest, ticks};
+  }
+  std::vector<AgentRecord> agents_;
+
+ private:
+  void onOdometry(std::size_t a, const nav_msgs::Odometry& msg) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    const int axes = scenario_.controller.model.double_integrator_axes;
+    const Eigen::Vector3d p(msg.pose.pose.position.x, msg.pose.pose.position.y,
+                            msg.pose.pose.position.z);
+    agents_[a].positions[msg.header.stamp] = p.head(axes);
+  }
+
+  std::vector<ros::Subscriber> subscribers_;
+};
+
+TEST_F(FormationTest, EveryFollowerHoldsItsSlotAsCfSimDoes) {
+  const double end_time = param("end_time");
+  const double tolerance = param("tolerance");
+  Scenario scenario = scenario_;
+  scenario.duration = end_time;
+  const FormationSummary expected = simulateFormation(scenario);
+  ASSERT_TRUE(waitForAll(end_time, param("wall_deadline")))
+      << "not every follower reached t = " << end_time << " s";
+  const std::lock_guard<std::mutex> lock(mutex_);
+  for (std::size_t i = 0; i < members_.size(); ++i) {
+    const FormationMember& member = members_[i];
+    const AgentRecord& agent = agents_[i + 1];
+    const SimulationSummary& cf_sim = expected.followers[i];
+    const ControllerDesign design =
+        ControllerDesign::create(memberParameters(scenario.controller, member));
+    SCOPED_TRACE(member.name + " -> " + member.target_name);
+    const auto [true_min_separation, matched_ticks] = trueMinSeparation(i + 1);
+    ROS_INFO(
+        "%s -> %s: ROS max |xi| %.4f, max |xi_hat| %.4f, min separation %.4f (true %.4f), "
+        "%d statuses; cf_sim %.4f, %.4f, %.4f",
+        member.name.c_str(), member.target_name.c_str(), agent.status.max_xi,
+        agent.status.max_xi_hat, agent.status.min_separation, true_min_separation,
+        agent.status.count, cf_sim.max_xi, cf_sim.max_xi_hat, cf_sim.min_separation);
+    EXPECT_EQ(agent.status.last.formation_index, static_cast<unsigned>(member.index));
+    EXPECT_EQ(agent.status.last.target, member.target_name);
+    EXPECT_EQ(agent.status.last.header.frame_id, member.name);
+    EXPECT_NEAR(agent.status.last.xi_max, design.xi_max, 1e-12);
+    EXPECT_GT(agent.status.count,
+              static_cast<int>(0.5 * end_time * scenario.controller.control_rate));
+    EXPECT_LE(agent.status.max_xi_hat, design.xi_max);
+    EXPECT_GT(matched_ticks, static_cast<int>(0.5 * end_time * scenario.controller.control_rate));
+    EXPECT_GT(true_min_separation, design.perimeter);
+    EXPECT_NEAR(agent.status.max_xi, cf_sim.max_xi, tolerance);
+    EXPECT_NEAR(agent.status.min_separation, cf_sim.min_separation, tolerance);
+  }
+}
+
+}  // namespace
+}  // namespace projection_collision_avoidance
+
+int main(int argc, char** argv) {
+  ::testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_formation_ros");
+  return RUN_ALL_TESTS();
+}
