@@ -29,39 +29,63 @@ work=$(mktemp -d)
 export ROS_LOG_DIR=$work/log
 Xvfb "$DISPLAY" -screen 0 1280x720x24 >"$work/xvfb.log" 2>&1 &
 xvfb=$!
-launch=
-stop_launch() {
-  [[ -n $launch ]] || return 0
-  kill -INT "$launch" 2>/dev/null || true
-  wait "$launch" 2>/dev/null || true
-  launch=
+pids=()  # roscore, rviz, roslaunch of the current shot
+stop_shot() {
+  local i
+  for (( i = ${#pids[@]} - 1; i >= 0; i-- )); do  # roslaunch first, roscore last
+    kill -INT "${pids[i]}" 2>/dev/null || true
+    wait "${pids[i]}" 2>/dev/null || true
+  done
+  pids=()
 }
-cleanup() { stop_launch; kill "$xvfb" 2>/dev/null || true; wait "$xvfb" 2>/dev/null || true;
+cleanup() { stop_shot; kill "$xvfb" 2>/dev/null || true; wait "$xvfb" 2>/dev/null || true;
             rm -rf "$work"; }
 trap cleanup EXIT
 
 # shoot SIMULATED_SECONDS OUTPUT.png RVIZ_CONFIG [roslaunch args...]
+# Starts the master and rviz first and the formation (rviz:=false) only once rviz's window is up,
+# so that a slow rviz start cannot miss the moment.
 shoot() {
-  local at=$1 output=$2 config=$3
+  local at=$1 output=$2 deadline
+  # The configuration without its panels (the Displays list): a wider 3-D view.
+  awk '/^Panels:/ { print "Panels: []"; skip = 1; next }
+       skip && /^ / { next }
+       { skip = 0; print }' "$3" >"$work/view.rviz"
   shift 3
-  roslaunch --port "$port" projection_collision_avoidance formation.launch rviz:=true \
-    rviz_config:="$config" sim_time:=true real_time_factor:="$rtf" "$@" >"$work/launch.log" 2>&1 &
-  launch=$!
-  # Wait (bounded) until simulated time passes $at.
-  local deadline=$((SECONDS + 240))
-  until /usr/bin/python3 - "$at" <<'PY' 2>/dev/null
-import sys, rospy
-from rosgraph_msgs.msg import Clock
-rospy.init_node("screenshot_clock", anonymous=True, disable_signals=True)
-t = rospy.wait_for_message("/clock", Clock, timeout=5).clock.to_sec()
-sys.exit(0 if t >= float(sys.argv[1]) else 1)
-PY
-  do
-    (( SECONDS < deadline )) || { tail -20 "$work/launch.log"; echo "no simulated time"; exit 1; }
+  roscore -p "$port" >"$work/roscore.log" 2>&1 &
+  pids+=($!)
+  deadline=$((SECONDS + 60))
+  until rosparam set /use_sim_time true 2>/dev/null; do
+    (( SECONDS < deadline )) || { cat "$work/roscore.log"; echo "no master"; exit 1; }
     sleep 0.5
   done
-  import -window root "$work/shot.png"
-  stop_launch
+  rviz -d "$work/view.rviz" >"$work/rviz.log" 2>&1 &
+  pids+=($!)
+  until xwininfo -root -tree | grep -q 'view.rviz - RViz'; do
+    (( SECONDS < deadline )) || { cat "$work/rviz.log"; echo "no rviz window"; exit 1; }
+    sleep 0.5
+  done
+  sleep 3
+  roslaunch --port "$port" projection_collision_avoidance formation.launch rviz:=false \
+    sim_time:=true real_time_factor:="$rtf" "$@" >"$work/launch.log" 2>&1 &
+  pids+=($!)
+  # Wait (bounded) until simulated time passes $at: one subscriber, up before the plant is.
+  if ! /usr/bin/python3 - "$at" 240 >/dev/null 2>&1 <<'PY'
+import sys, threading, rospy
+from rosgraph_msgs.msg import Clock
+at, timeout = float(sys.argv[1]), float(sys.argv[2])
+passed = threading.Event()
+rospy.init_node("screenshot_clock", anonymous=True, disable_signals=True)
+rospy.Subscriber("/clock", Clock, lambda m: m.clock.to_sec() >= at and passed.set(), queue_size=1)
+sys.exit(0 if passed.wait(timeout) else 1)
+PY
+  then
+    tail -20 "$work/launch.log"; echo "no simulated time $at s"; exit 1
+  fi
+  # rviz's window alone (its size is the configuration's Window Geometry).
+  import -window "$(xwininfo -name 'view.rviz - RViz' | awk '/Window id:/ { print $4 }')" \
+    "$work/shot.png"
+  stop_shot
   convert "$work/shot.png" -colors 256 "PNG8:$output"
   echo "wrote $output ($(stat -c %s "$output") bytes)"
 }
@@ -72,7 +96,7 @@ for shot in "${shots[@]}"; do
           scenario:="$root/config/scenarios/figure_eight_2d.yaml" followers:=4 topology:=star shape:=v ;;
     3d) shoot 22 "$out/rviz_formation_3d.png" "$root/rviz/formation_3d.rviz" \
           scenario:="$root/config/scenarios/figure_eight_3d.yaml" followers:=4 topology:=chain shape:=v ;;
-    chain) shoot 22 "$out/rviz_formation_chain.png" "$root/rviz/formation.rviz" \
+    chain) shoot 22 "$out/rviz_formation_chain.png" "$root/rviz/formation_line.rviz" \
           scenario:="$root/config/scenarios/paper_run2.yaml" followers:=5 topology:=chain \
           shape:=line control_rate:=100 ;;
     *) echo "formation_screenshots: unknown shot '$shot' (2d, 3d, chain)"; exit 1 ;;

@@ -1,6 +1,9 @@
 #include "projection_collision_avoidance/ControllerDesign.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <complex>
+#include <sstream>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
@@ -108,6 +111,51 @@ Eigen::MatrixXd doubleIntegratorFallbackGain(int axes, double velocity_gain) {
   return gain;
 }
 
+namespace {
+
+/// max |R(h lambda)| over the eigenvalues lambda of F, with R(z) = 1 + z + z^2/2 + z^3/6 + z^4/24
+/// the amplification of one classical RK4 step on x' = lambda x.
+double rk4Amplification(const Eigen::VectorXcd& eigenvalues_of_f, double h) {
+  double largest = 0.0;
+  for (Eigen::Index i = 0; i < eigenvalues_of_f.size(); ++i) {
+    const std::complex<double> z = h * eigenvalues_of_f(i);
+    const std::complex<double> r = 1.0 + z * (1.0 + z * (0.5 + z * (1.0 / 6.0 + z / 24.0)));
+    largest = std::max(largest, std::abs(r));
+  }
+  return largest;
+}
+
+/// The estimator's RK4 substeps must be stable for its linear part A_c + L C: |R(h lambda)| <= 1
+/// with h = T / substeps. (Beyond that the bound ||xi_hat|| <= xi_max still holds, by the
+/// projection and its safeguard, but the estimate is numerical noise.)
+void requireStableEstimatorSteps(const Eigen::MatrixXd& estimator_matrix, double period,
+                                 int substeps) {
+  const Eigen::VectorXcd lambda = eigenvalues(estimator_matrix);
+  const double amplification = rk4Amplification(lambda, period / substeps);
+  if (amplification <= 1.0 + kRelativeTolerance) {
+    return;
+  }
+  int needed = substeps + 1;
+  while (needed <= kMaxEstimatorSubsteps &&
+         rk4Amplification(lambda, period / needed) > 1.0 + kRelativeTolerance) {
+    ++needed;
+  }
+  std::ostringstream why;
+  why << "RK4 of the estimator is unstable with h = T / substeps = " << period / substeps
+      << " s: |R(h lambda)| = " << amplification
+      << " > 1 for an eigenvalue lambda of A_c + L C (eigenvalues " << formatEigenvalues(lambda)
+      << "); ";
+  if (needed <= kMaxEstimatorSubsteps) {
+    why << "use substeps >= " << needed << ", a higher control_rate or a smaller L";
+  } else {
+    why << "no substeps up to " << kMaxEstimatorSubsteps
+        << " suffice: use a higher control_rate or a smaller L";
+  }
+  throw ParameterError("controller.estimator.substeps", why.str());
+}
+
+}  // namespace
+
 ControllerDesign ControllerDesign::create(const ControllerParameters& parameters) {
   const ControllerParameters& p = parameters;
   validateAgentModel(p.model);
@@ -179,13 +227,15 @@ ControllerDesign ControllerDesign::create(const ControllerParameters& parameters
             formatEigenvalues(eigenvalues(design.fallback_matrix)));
   }
 
+  design.period = 1.0 / p.control_rate;
+  requireStableEstimatorSteps(design.estimator_matrix, design.period, p.estimator_substeps);
+
   design.output_pseudoinverse = C.completeOrthogonalDecomposition().pseudoInverse();
   design.input_pseudoinverse = B.completeOrthogonalDecomposition().pseudoInverse();
   if (p.leader_disturbance_shared && !p.leader_input_in_command && !p.leader_input_in_estimator) {
     throw ParameterError("controller.leader_information.disturbance",
                          "shares nothing unless leader_information.command or .estimator is true");
   }
-  design.period = 1.0 / p.control_rate;
   const double d_norm = p.separation.norm();
   design.xi_max = (1.0 - p.alpha) * d_norm;
   design.xi_soft = design.xi_max / std::sqrt(1.0 + p.epsilon);

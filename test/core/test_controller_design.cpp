@@ -197,6 +197,24 @@ TEST(ControllerDesign, RefusesBadRatesAndSubsteps) {
   expectRefused([](auto& p) { p.estimator_substeps = 100000; }, "controller.estimator.substeps");
 }
 
+// Explicit RK4 of the estimator is stable only while |R(h lambda)| <= 1 for the eigenvalues of
+// A_c + L C; L = -500 I at 100 Hz puts h lambda near -5, beyond RK4's interval [-2.79, 0].
+TEST(ControllerDesign, RefusesEstimatorSubstepsThatRk4CannotIntegrate) {
+  expectRefused([](auto& p) { p.estimator_gain = -500.0 * Eigen::Matrix2d::Identity(); },
+                "controller.estimator.substeps", "use substeps >= 2");
+  ControllerParameters p = testing::paperParameters();
+  p.estimator_gain = -500.0 * Eigen::Matrix2d::Identity();
+  p.estimator_substeps = 2;
+  EXPECT_NO_THROW(ControllerDesign::create(p));
+  // h lambda near -1e6 at 1 Hz: not even 1000 substeps are enough.
+  expectRefused(
+      [](auto& q) {
+        q.estimator_gain = -1e6 * Eigen::Matrix2d::Identity();
+        q.control_rate = 1.0;
+      },
+      "controller.estimator.substeps", "no substeps up to 1000");
+}
+
 TEST(ControllerDesign, AcceptsAGeneralLinearModel) {
   // A damped oscillator with only its position measured: x = [p, v], y = p.
   ControllerParameters p = paperParameters();

@@ -68,14 +68,25 @@ TEST(SweepScenario, RefusesWhatItCannotSweep) {
   EXPECT_THROW(options.validate(), ParameterError);
 }
 
-TEST(DisturbanceSweep, FindsTheLimitsAtTheEdgeOfSafety) {
+/// A coarse sweep: 0, 90, 180, 270 deg, sizes up to 8 in steps of 1, on 40 s of Run 2.
+SweepOptions coarseOptions() {
   SweepOptions options;
-  options.directions = 4;  // 0, 90, 180, 270 deg
+  options.directions = 4;
   options.max_size = 8.0;
   options.size_step = 1.0;
   options.tolerance = 0.01;
-  Scenario short_run = base();
-  short_run.duration = 40.0;
+  return options;
+}
+
+Scenario shortRun() {
+  Scenario scenario = base();
+  scenario.duration = 40.0;
+  return scenario;
+}
+
+TEST(DisturbanceSweep, FindsTheLimitsAtTheEdgeOfSafety) {
+  const SweepOptions options = coarseOptions();
+  const Scenario short_run = shortRun();
   const std::vector<SweepPoint> points = sweepDisturbance(short_run, options);
   ASSERT_EQ(points.size(), sweepConfigurations().size() * 4);
   for (const SweepPoint& point : points) {
@@ -106,14 +117,7 @@ TEST(DisturbanceSweep, FindsTheLimitsAtTheEdgeOfSafety) {
 }
 
 TEST(DisturbanceSweep, SharingHelpsAgainstAccelerationsAndNotAgainstPositionRates) {
-  SweepOptions options;
-  options.directions = 4;
-  options.max_size = 8.0;
-  options.size_step = 1.0;
-  options.tolerance = 0.01;
-  Scenario short_run = base();
-  short_run.duration = 40.0;
-  const std::vector<SweepPoint> points = sweepDisturbance(short_run, options);
+  const std::vector<SweepPoint> points = sweepDisturbance(shortRun(), coarseOptions());
   const auto find = [&](bool tracker, LeaderSharing sharing, int direction) {
     for (const SweepPoint& p : points) {
       if (p.configuration.tracker == tracker && p.configuration.sharing == sharing &&
