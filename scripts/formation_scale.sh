@@ -6,7 +6,10 @@
 # wall seconds, stops the launch and checks that nothing of it remains (scripts/formation_scale.py).
 # Writes OUT_DIR/formation_scale.md (table) and OUT_DIR/formation_scale.png (CPU and rate vs N).
 # Usage: scripts/formation_scale.sh [N ...]     (default 1 2 4 8 16 32 64; a mode stops at the
-#                                                first N that fails badly)
+#                                                first N that fails badly twice)  ~17 min
+#   KEEP_AWAKE: both (default) runs every size twice, first on the machine as it is, then with a
+#   nice-19 busy loop per core that keeps the VM's cores from halting when idle (on a VM, waking
+#   a halted core can delay a timer by tens of ms); no or yes for one of the two passes.
 #   WINDOW (default 20 s), MODES (default "processes nodelets"), RATE (default 100 Hz),
 #   ROS_PORT (default 11411), OUT_DIR (default doc/), RESULTS (raw results, JSON lines; default
 #   a temporary file). Needs a built workspace (scripts/build.sh).
@@ -15,6 +18,7 @@ set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 out=${OUT_DIR:-$root/doc}
 window=${WINDOW:-20}
+keep_awake=${KEEP_AWAKE:-both}
 rate=${RATE:-100}
 port=${ROS_PORT:-11411}
 read -r -a modes <<<"${MODES:-processes nodelets}"
@@ -32,9 +36,11 @@ results=${RESULTS:-$(mktemp --suffix=.jsonl)}
 command="scripts/formation_scale.sh ${sizes[*]}"
 [[ $window == 20 ]] || command="WINDOW=$window $command"
 [[ ${MODES:-} == "" ]] || command="MODES=\"${MODES}\" $command"
+[[ $keep_awake == both ]] || command="KEEP_AWAKE=$keep_awake $command"
 start=$SECONDS
 /usr/bin/python3 "$root/scripts/formation_scale.py" run --results "$results" \
-  --sizes "${sizes[@]}" --modes "${modes[@]}" --window "$window" --rate "$rate" --port "$port"
+  --sizes "${sizes[@]}" --modes "${modes[@]}" --window "$window" --rate "$rate" --port "$port" \
+  --keep-awake "$keep_awake"
 wall=$((SECONDS - start))
 /usr/bin/python3 "$root/scripts/formation_scale.py" report --results "$results" \
   --md "$out/formation_scale.md" --png "$out/formation_scale.png" --port "$port" \

@@ -1,11 +1,15 @@
 #!/usr/bin/env bash
 # Takes the README's rviz screenshots of formation.launch, as scripts/make_screenshot.sh does for
-# demo.launch: the launch with rviz under Xvfb (software OpenGL), captured with `import` once the
-# plant's simulated time passes the given moment.
-#   doc/rviz_formation_2d.png     figure_eight_2d, 4 followers, star, V, t ~ 21.5 s (disturbance)
-#   doc/rviz_formation_3d.png     figure_eight_3d, 4 followers, chain, V, t ~ 22 s, pitched view
-#                                 (rviz/formation_3d.rviz)
-#   doc/rviz_formation_chain.png  paper_run2 (1-D), 5 followers, chain, line, 100 Hz, t ~ 22 s
+# demo.launch: rviz under Xvfb (software OpenGL) on the formation, its window captured with
+# `import` once the plant's simulated time passes the given moment. The master and rviz start
+# first and formation.launch (rviz:=false) only once rviz's window is up; rviz runs a copy of the
+# configuration without its Displays panel, for a wider view.
+#   doc/rviz_formation_2d.png     figure_eight_2d, 4 followers, star, V, t = 21.5 s (during the
+#                                 disturbance), rviz/formation.rviz
+#   doc/rviz_formation_3d.png     figure_eight_3d, 4 followers, chain, V, t = 22 s, a low camera
+#                                 over the ground grid (rviz/formation_3d.rviz)
+#   doc/rviz_formation_chain.png  paper_run2 (1-D), 5 followers, chain, line, 100 Hz, t = 22 s,
+#                                 side view in a 1280x420 window (rviz/formation_line.rviz)
 # Usage: scripts/formation_screenshots.sh [2d] [3d] [chain]   (default: all three; ~1 min each)
 #   OUT_DIR (default doc/), REAL_TIME_FACTOR (default 0.5), ROS_PORT (default 11412: its own
 #   master, apart from other tests), SCREEN_DISPLAY (default :98). Needs a built workspace

@@ -126,8 +126,10 @@ double rk4Amplification(const Eigen::VectorXcd& eigenvalues_of_f, double h) {
 }
 
 /// The estimator's RK4 substeps must be stable for its linear part A_c + L C: |R(h lambda)| <= 1
-/// with h = T / substeps. (Beyond that the bound ||xi_hat|| <= xi_max still holds, by the
-/// projection and its safeguard, but the estimate is numerical noise.)
+/// with h = T / substeps. Refused naming controller.estimator.substeps when more substeps would
+/// do, controller.control_rate when not even kMaxEstimatorSubsteps would. (Beyond that the bound
+/// ||xi_hat|| <= xi_max still holds, by the projection and its safeguard, but the estimate is
+/// numerical noise.)
 void requireStableEstimatorSteps(const Eigen::MatrixXd& estimator_matrix, double period,
                                  int substeps) {
   const Eigen::VectorXcd lambda = eigenvalues(estimator_matrix);
@@ -147,11 +149,12 @@ void requireStableEstimatorSteps(const Eigen::MatrixXd& estimator_matrix, double
       << "); ";
   if (needed <= kMaxEstimatorSubsteps) {
     why << "use substeps >= " << needed << ", a higher control_rate or a smaller L";
-  } else {
-    why << "no substeps up to " << kMaxEstimatorSubsteps
-        << " suffice: use a higher control_rate or a smaller L";
+    throw ParameterError("controller.estimator.substeps", why.str());
   }
-  throw ParameterError("controller.estimator.substeps", why.str());
+  // No number of substeps helps: the rate (or L) is what is wrong.
+  why << "no substeps up to " << kMaxEstimatorSubsteps
+      << " suffice: use a higher control_rate or a smaller L";
+  throw ParameterError("controller.control_rate", why.str());
 }
 
 }  // namespace

@@ -74,7 +74,7 @@ FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh, const
       InputGuard("relative_measurement", options_.measurement_frame, options_.max_future_stamp);
   leader_guard_ =
       InputGuard("leader_broadcast", options_.leader_broadcast_frame, options_.max_future_stamp);
-  const std::string name = ros::this_node::getName();
+  const std::string name = private_nh_.getNamespace();
   echoScenario(name, private_nh);
   reader.echo(name);
 
@@ -145,7 +145,7 @@ void FollowerNode::onLeaderBroadcast(const LeaderBroadcast::ConstPtr& msg) {
 }
 
 void FollowerNode::logModeChange(FollowerMode mode) {
-  const std::string name = ros::this_node::getName();
+  const std::string name = private_nh_.getNamespace();
   switch (mode) {
     case FollowerMode::kTracking:
       ROS_INFO_STREAM(name << ": tracking");
@@ -378,13 +378,13 @@ void FollowerNode::onReconfigure(FollowerConfig& config, uint32_t /*level*/) {
     }
     controller_.setDesign(ControllerDesign::create(candidate));
     parameters_ = candidate;
-    ROS_INFO_STREAM(ros::this_node::getName()
+    ROS_INFO_STREAM(private_nh_.getNamespace()
                     << ": reconfigured: tracker " << (candidate.tracker_enabled ? "on" : "off")
                     << ", alpha " << candidate.alpha << ", epsilon " << candidate.epsilon
                     << ", xi_max " << controller_.design().xi_max << " m");
     applied_config_ = config;
   } catch (const ParameterError& error) {
-    ROS_ERROR_STREAM(ros::this_node::getName()
+    ROS_ERROR_STREAM(private_nh_.getNamespace()
                      << ": reconfiguration refused, previous values kept: " << error.what());
     config = applied_config_;
   }

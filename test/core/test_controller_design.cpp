@@ -206,13 +206,13 @@ TEST(ControllerDesign, RefusesEstimatorSubstepsThatRk4CannotIntegrate) {
   p.estimator_gain = -500.0 * Eigen::Matrix2d::Identity();
   p.estimator_substeps = 2;
   EXPECT_NO_THROW(ControllerDesign::create(p));
-  // h lambda near -1e6 at 1 Hz: not even 1000 substeps are enough.
+  // h lambda near -1e6 at 1 Hz: not even 1000 substeps are enough; the rate is named.
   expectRefused(
       [](auto& q) {
         q.estimator_gain = -1e6 * Eigen::Matrix2d::Identity();
         q.control_rate = 1.0;
       },
-      "controller.estimator.substeps", "no substeps up to 1000");
+      "controller.control_rate", "no substeps up to 1000");
 }
 
 TEST(ControllerDesign, AcceptsAGeneralLinearModel) {

@@ -6,8 +6,9 @@
 ///   ~tolerance       largest difference to cf_sim of each follower's max ||xi|| and min
 ///                    separation (m)
 ///   ~wall_deadline   wall seconds to wait for end_time
-/// Every follower must report its own place (formation index, target), keep ||xi_hat|| within
-/// its xi_max, and keep its target outside its perimeter by the plant's odometry.
+/// Every follower must report its own place (formation index, target), hear its target's
+/// broadcast, keep ||xi_hat|| within its xi_max, and keep its target outside its perimeter by the
+/// plant's odometry.
 
 #include <cstddef>
 #include <limits>
@@ -155,6 +156,9 @@ TEST_F(FormationTest, EveryFollowerHoldsItsSlotAsCfSimDoes) {
     EXPECT_EQ(agent.status.last.formation_index, static_cast<unsigned>(member.index));
     EXPECT_EQ(agent.status.last.target, member.target_name);
     EXPECT_EQ(agent.status.last.header.frame_id, member.name);
+    // The target's broadcast (the leader's, or the command of the follower ahead) is heard and
+    // accepted, although it carries no state in a chain.
+    EXPECT_TRUE(agent.status.last.leader_fresh);
     EXPECT_NEAR(agent.status.last.xi_max, design.xi_max, 1e-12);
     EXPECT_GT(agent.status.count,
               static_cast<int>(0.5 * end_time * scenario.controller.control_rate));

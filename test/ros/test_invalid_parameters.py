@@ -40,7 +40,7 @@ FOLLOWER, PLANT, LEADER = "follower_node", "plant_node", "leader_node"
 ALL_NODES = (FOLLOWER, PLANT, LEADER)
 # What each node logs once it runs, i.e. once it has accepted its parameters.
 RUNNING = {
-    FOLLOWER: ": running at ",
+    FOLLOWER: ", running at ",
     PLANT: ": simulating a leader",
     LEADER: ": playing the leader's input",
 }
