@@ -14,12 +14,9 @@
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 out=${1:-$root/doc}
-if [[ -z ${CF_SIM:-} ]]; then
-  build_dir=${BUILD_DIR:-$root/build}
-  BUILD_DIR=$build_dir "$root/scripts/build.sh" >/dev/null
-  CF_SIM=$build_dir/devel/lib/projection_collision_avoidance/cf_sim
-fi
-test -x "$CF_SIM" || { echo "string_stability: no cf_sim at $CF_SIM"; exit 1; }
+# shellcheck source=scripts/cf_sim_path.bash
+source "$root/scripts/cf_sim_path.bash"
+find_cf_sim string_stability "$root"
 mkdir -p "$out"
 
 scenario=$root/config/scenarios/paper_run2.yaml
