@@ -7,6 +7,7 @@ set(PCA_CORE_SOURCES
   src/core/AgentIntegrator.cpp
   src/core/AgentModel.cpp
   src/core/ClosedLoopSimulator.cpp
+  src/core/ContinuousSimulator.cpp
   src/core/ControllerDesign.cpp
   src/core/DisturbanceSweep.cpp
   src/core/ExactDiscretization.cpp

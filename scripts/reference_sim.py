@@ -707,7 +707,7 @@ def signals_on_grid(sc, grid, Z):
 def write_csv(path, cols):
     names = list(cols)
     data = np.column_stack([cols[c] for c in names])
-    np.savetxt(path, data, fmt="%.9g", delimiter=",", header=",".join(names), comments="")
+    np.savetxt(path, data, fmt="%.17g", delimiter=",", header=",".join(names), comments="")
 
 
 def summary(sc, cols, wall):

@@ -16,6 +16,9 @@ namespace projection_collision_avoidance {
 /// min_pair_separation=.. wall_s=..`; its CSV is one file per follower, FILE with `_follower_<i>`
 /// before the extension.
 ///
+/// `... --continuous STEP` runs the pair's continuous-time loop instead (simulateContinuous(), RK4
+/// at STEP s; the sampled controller is not involved); the CSV then has one row per step.
+///
 /// `... --sweep FILE [--directions N] [--max-size S] [--size-step S] [--tolerance S]` runs
 /// sweepDisturbance() on the scenario and writes one CSV row per configuration and direction:
 /// `tracker,sharing,direction_deg,bound_limit,bound_capped,perimeter_limit,perimeter_capped`.

@@ -30,6 +30,16 @@ struct SignalProfile {
   /// The signal at time t (s), a vector of @p size entries.
   Eigen::VectorXd value(double t, Eigen::Index size) const;
 
+  /// Adds the signal at time t (s) to @p result (its size entries); allocates no memory.
+  void addTo(double t, Eigen::Ref<Eigen::VectorXd> result) const;
+  /// Adds the pulses' part of the signal at time t (s) to @p result; allocates no memory.
+  void addPulsesTo(double t, Eigen::Ref<Eigen::VectorXd> result) const;
+  /// Adds the sinusoids' part of the signal at time t (s) to @p result; allocates no memory.
+  void addSinusoidsTo(double t, Eigen::Ref<Eigen::VectorXd> result) const;
+  /// Whether the signal has sinusoids (is not piecewise constant).
+  bool hasSinusoids() const { return !sinusoids.empty(); }
+  /// Whether a pulse edge lies strictly inside (t0, t1); allocates no memory.
+  bool hasEdgeWithin(double t0, double t1) const;
   /// Pulse edges strictly inside (t0, t1), sorted.
   std::vector<double> edgesWithin(double t0, double t1) const;
 

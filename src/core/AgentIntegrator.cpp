@@ -87,10 +87,7 @@ void AgentIntegrator<Dims>::advance(double t, double dt, const InputVector& inpu
   // Split the step at the disturbance's pulse edges; evaluate w mid-segment so that an edge that
   // rounding puts a hair away from a tick does not flip the pulse's state.
   const double tolerance = 1e-9 * dt;
-  const std::vector<double> edges =
-      disturbance_.pulses.empty() ? std::vector<double>()
-                                  : disturbance_.edgesWithin(t + tolerance, t_end - tolerance);
-  if (edges.empty()) {
+  if (!disturbance_.hasEdgeWithin(t + tolerance, t_end - tolerance)) {
     if (dt == nominal_step_) {
       advanceSegment(t, t_end, transition_, integral_, drive);
     } else {
@@ -99,7 +96,7 @@ void AgentIntegrator<Dims>::advance(double t, double dt, const InputVector& inpu
     return;
   }
   double a = t;
-  for (const double edge : edges) {
+  for (const double edge : disturbance_.edgesWithin(t + tolerance, t_end - tolerance)) {
     advanceUncached(a, edge, drive);
     a = edge;
   }
@@ -112,7 +109,7 @@ void AgentIntegrator<Dims>::advanceSegment(double a, double b, const Matrix& tra
                                            const Matrix& integral, const StateVector& drive) {
   if (disturbed_) {
     StateVector w = drive;
-    w += disturbance_.value(0.5 * (a + b), state_matrix_.rows());
+    disturbance_.addTo(0.5 * (a + b), w);
     state_ = transition * state_ + integral * w;
   } else {
     state_ = transition * state_ + integral * drive;

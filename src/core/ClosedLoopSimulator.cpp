@@ -88,9 +88,12 @@ FormationSummary runFormation(const Scenario& scenario, const ControllerDesign& 
   const long last_tick = std::lround(scenario.duration * p.control_rate);
   for (long tick = 0; tick <= last_tick; ++tick) {
     const double t = static_cast<double>(tick) / p.control_rate;
-    const InputVector leader_input = scenario.leader_input.value(t, m);
-    const StateVector disturbance =
-        need_disturbance ? StateVector(scenario.disturbance.value(t, n)) : zero_disturbance;
+    InputVector leader_input = InputVector::Zero(m);
+    scenario.leader_input.addTo(t, leader_input);
+    StateVector disturbance = zero_disturbance;
+    if (need_disturbance) {
+      scenario.disturbance.addTo(t, disturbance);
+    }
     InputVector leader_acceleration = leader_input;  // a_1 = u_1 (+ pinv(B) u_d)
     if (share_disturbance) {
       leader_acceleration += input_pseudoinverse * disturbance;

@@ -12,15 +12,36 @@ namespace projection_collision_avoidance {
 
 Eigen::VectorXd SignalProfile::value(double t, Eigen::Index size) const {
   Eigen::VectorXd result = Eigen::VectorXd::Zero(size);
+  addTo(t, result);
+  return result;
+}
+
+void SignalProfile::addTo(double t, Eigen::Ref<Eigen::VectorXd> result) const {
+  addPulsesTo(t, result);
+  addSinusoidsTo(t, result);
+}
+
+void SignalProfile::addPulsesTo(double t, Eigen::Ref<Eigen::VectorXd> result) const {
   for (const Pulse& pulse : pulses) {
     if (pulse.start <= t && t < pulse.end) {
       result += pulse.vector;
     }
   }
+}
+
+void SignalProfile::addSinusoidsTo(double t, Eigen::Ref<Eigen::VectorXd> result) const {
   for (const Sinusoid& wave : sinusoids) {
     result += wave.amplitude * std::sin(2.0 * M_PI * wave.frequency * t + wave.phase);
   }
-  return result;
+}
+
+bool SignalProfile::hasEdgeWithin(double t0, double t1) const {
+  for (const Pulse& pulse : pulses) {
+    if ((pulse.start > t0 && pulse.start < t1) || (pulse.end > t0 && pulse.end < t1)) {
+      return true;
+    }
+  }
+  return false;
 }
 
 std::vector<double> SignalProfile::edgesWithin(double t0, double t1) const {

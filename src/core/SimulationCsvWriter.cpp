@@ -30,7 +30,7 @@ SimulationCsvWriter::SimulationCsvWriter(std::ostream& out, const Scenario& scen
       xi_max_((1.0 - scenario.controller.alpha) * scenario.controller.separation.norm()),
       xi_soft_(xi_max_ / std::sqrt(1.0 + scenario.controller.epsilon)),  // xi_max_ is set above
       perimeter_(scenario.controller.alpha * scenario.controller.separation.norm()) {
-  out_.precision(10);
+  out_.precision(17);  // round-trip: a reader gets the very doubles
   out_ << 't';
   writeHeaderColumns(out_, "xi_", states_);
   writeHeaderColumns(out_, "xi_hat_", states_);

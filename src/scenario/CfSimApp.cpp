@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "projection_collision_avoidance/ClosedLoopSimulator.hpp"
+#include "projection_collision_avoidance/ContinuousSimulator.hpp"
 #include "projection_collision_avoidance/DisturbanceSweep.hpp"
 #include "projection_collision_avoidance/ParameterError.hpp"
 #include "projection_collision_avoidance/ScenarioLoader.hpp"
@@ -23,7 +24,7 @@ namespace projection_collision_avoidance {
 namespace {
 
 constexpr const char* kUsage =
-    "usage: cf_sim SCENARIO.yaml [--set key=value]... [--csv FILE]\n"
+    "usage: cf_sim SCENARIO.yaml [--set key=value]... [--continuous STEP] [--csv FILE]\n"
     "       cf_sim SCENARIO.yaml [--set key=value]... --sweep FILE [--directions N]\n"
     "              [--max-size S] [--size-step S] [--tolerance S]";
 
@@ -35,6 +36,7 @@ struct Options {
   std::string csv_path;
   std::string sweep_path;
   SweepOptions sweep;
+  double continuous_step = 0.0;  // s; > 0: simulateContinuous() at this step
 };
 
 /// Parses a number option's value; false (with a message) if it is not one.
@@ -53,8 +55,9 @@ bool parseNumber(const std::string& option, const std::string& text, double* val
 }
 
 bool parseOptions(const std::vector<std::string>& arguments, Options* options, std::ostream& err) {
-  const std::vector<std::string> valued = {
-      "--set", "--csv", "--sweep", "--directions", "--max-size", "--size-step", "--tolerance"};
+  const std::vector<std::string> valued = {"--set",        "--csv",       "--sweep",
+                                           "--directions", "--max-size",  "--size-step",
+                                           "--tolerance",  "--continuous"};
   for (std::size_t i = 0; i < arguments.size(); ++i) {
     const std::string& argument = arguments[i];
     bool takes_value = false;
@@ -82,6 +85,12 @@ bool parseOptions(const std::vector<std::string>& arguments, Options* options, s
           return false;
         }
         options->sweep.directions = static_cast<int>(number);
+      } else if (argument == "--continuous") {
+        if (!(number > 0.0)) {
+          err << "cf_sim: --continuous needs a step > 0 (s), got '" << value << "'\n";
+          return false;
+        }
+        options->continuous_step = number;
       } else if (argument == "--max-size") {
         options->sweep.max_size = number;
       } else if (argument == "--size-step") {
@@ -104,6 +113,10 @@ bool parseOptions(const std::vector<std::string>& arguments, Options* options, s
   }
   if (options->scenario_path.empty()) {
     err << kUsage << "\n";
+    return false;
+  }
+  if (!options->sweep_path.empty() && options->continuous_step > 0.0) {
+    err << "cf_sim: --sweep and --continuous do not go together\n" << kUsage << "\n";
     return false;
   }
   if (!options->sweep_path.empty() && !options->csv_path.empty()) {
@@ -154,7 +167,17 @@ int runSimulation(const Scenario& scenario, const Options& options, std::ostream
     };
   }
   const auto start = std::chrono::steady_clock::now();
-  const FormationSummary summary = simulateFormation(scenario, observer);
+  FormationSummary summary;
+  if (options.continuous_step > 0.0) {
+    SampleObserver pair_observer;
+    if (observer) {
+      pair_observer = [&observer](const SimulationSample& sample) { observer(0, sample); };
+    }
+    summary.followers.push_back(
+        simulateContinuous(scenario, options.continuous_step, pair_observer));
+  } else {
+    summary = simulateFormation(scenario, observer);
+  }
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   for (std::size_t i = 0; i < csv_files.size(); ++i) {

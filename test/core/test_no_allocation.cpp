@@ -1,60 +1,20 @@
-/// A control step allocates no memory. The C allocation functions are replaced by counting
-/// ones that forward to glibc's, so every heap allocation is seen: operator new, std::allocator
-/// and Eigen's aligned_malloc all end in malloc. (Not for sanitizer builds, which replace malloc
-/// themselves.)
+/// A control step allocates no memory (counted by test/common/AllocationCounter.cpp).
 
-#include <atomic>
 #include <cstddef>
 #include <vector>
 
 #include <Eigen/Core>
 #include <gtest/gtest.h>
 
+#include "projection_collision_avoidance/AgentIntegrator.hpp"
+#include "projection_collision_avoidance/ClosedLoopSimulator.hpp"
 #include "projection_collision_avoidance/ControllerDesign.hpp"
 #include "projection_collision_avoidance/FollowerController.hpp"
 #include "projection_collision_avoidance/RuntimeFollowerController.hpp"
 #include "projection_collision_avoidance/ScenarioEmbedding.hpp"
 
+#include "AllocationCounter.hpp"
 #include "TestScenarios.hpp"
-
-namespace {
-std::atomic<long> g_allocations{0};
-}  // namespace
-
-extern "C" {
-void* __libc_malloc(std::size_t size);
-void* __libc_calloc(std::size_t count, std::size_t size);
-void* __libc_realloc(void* pointer, std::size_t size);
-void* __libc_memalign(std::size_t alignment, std::size_t size);
-void __libc_free(void* pointer);
-
-void* malloc(std::size_t size) {
-  ++g_allocations;
-  return __libc_malloc(size);
-}
-void* calloc(std::size_t count, std::size_t size) {
-  ++g_allocations;
-  return __libc_calloc(count, size);
-}
-void* realloc(void* pointer, std::size_t size) {
-  ++g_allocations;
-  return __libc_realloc(pointer, size);
-}
-void* memalign(std::size_t alignment, std::size_t size) {
-  ++g_allocations;
-  return __libc_memalign(alignment, size);
-}
-void* aligned_alloc(std::size_t alignment, std::size_t size) {
-  ++g_allocations;
-  return __libc_memalign(alignment, size);
-}
-int posix_memalign(void** pointer, std::size_t alignment, std::size_t size) {
-  ++g_allocations;
-  *pointer = __libc_memalign(alignment, size);
-  return *pointer == nullptr ? 12 /* ENOMEM */ : 0;
-}
-void free(void* pointer) { __libc_free(pointer); }
-}
 
 namespace projection_collision_avoidance {
 namespace {
@@ -68,7 +28,7 @@ long allocationsDuringSteps(const ControllerDesign& design, int steps) {
   typename Dims::OutputVector y(design.parameters.model.outputDimension());
   typename Dims::InputVector u1(design.parameters.model.inputDimension());
   u1.setConstant(0.3);
-  const long before = g_allocations.load();
+  const long before = testing::allocationCount();
   double sink = 0.0;
   for (int k = 0; k < steps; ++k) {
     y.setConstant((k / 50) % 2 == 0 ? 0.2 : 7.0);
@@ -77,7 +37,7 @@ long allocationsDuringSteps(const ControllerDesign& design, int steps) {
     sink += controller.stepFallback().command(0);
     sink += controller.stepFallback(u1).command(0);
   }
-  const long after = g_allocations.load();
+  const long after = testing::allocationCount();
   EXPECT_TRUE(std::isfinite(sink));
   return after - before;
 }
@@ -94,11 +54,11 @@ ControllerDesign designFor(int axes, bool share) {
 }
 
 TEST(NoAllocation, CounterSeesAllocations) {
-  const long before = g_allocations.load();
+  const long before = testing::allocationCount();
   Eigen::VectorXd heap = Eigen::VectorXd::Ones(100);
-  const long after_eigen = g_allocations.load();
+  const long after_eigen = testing::allocationCount();
   std::vector<double> vector(100, 1.0);
-  const long after_vector = g_allocations.load();
+  const long after_vector = testing::allocationCount();
   EXPECT_GE(after_eigen - before, 1);
   EXPECT_GE(after_vector - after_eigen, 1);
   EXPECT_EQ(heap.sum() + vector.back(), 101.0);
@@ -118,7 +78,7 @@ TEST(NoAllocation, ControlStepsOfTheRuntimeController) {
     Eigen::VectorXd y = Eigen::VectorXd::Constant(2 * axes, 0.2);
     const Eigen::VectorXd u1 = Eigen::VectorXd::Constant(axes, 0.3);
     controller.step(y);
-    const long before = g_allocations.load();
+    const long before = testing::allocationCount();
     for (int k = 0; k < 1000; ++k) {
       y.setConstant((k / 50) % 2 == 0 ? 0.2 : 7.0);
       controller.step(y);
@@ -126,12 +86,46 @@ TEST(NoAllocation, ControlStepsOfTheRuntimeController) {
       controller.stepFallback();
       controller.stepFallback(u1);
     }
-    EXPECT_EQ(g_allocations.load() - before, 0) << axes << " axes";
+    EXPECT_EQ(testing::allocationCount() - before, 0) << axes << " axes";
   }
 }
 
 TEST(NoAllocation, ControlStepsOfTheGenericController) {
   EXPECT_EQ(allocationsDuringSteps<GenericDimensions>(designFor(3, true), 1000), 0);
+}
+
+TEST(NoAllocation, DisturbedAgentStepsAwayFromPulseEdges) {
+  const Scenario scenario = loadScenarioFile(testing::scenarioPath("paper_run2.yaml"));
+  AgentIntegrator<DoubleIntegrator1D> leader(scenario.controller.model, 1e-3,
+                                             scenario.leader_initial_state, scenario.disturbance);
+  const DoubleIntegrator1D::InputVector input = DoubleIntegrator1D::InputVector::Constant(0.1);
+  const long before = testing::allocationCount();
+  for (int k = 19000; k < 24000; ++k) {  // across the pulse [20 s, 23 s), edges on ticks
+    leader.advance(1e-3 * k, input);
+  }
+  EXPECT_EQ(testing::allocationCount() - before, 0);
+  EXPECT_TRUE(leader.state().allFinite());
+}
+
+/// The sampled closed loop allocates while it sets up and nothing per tick: a run twice as long
+/// allocates exactly as much.
+TEST(NoAllocation, SampledSimulationPerTick) {
+  for (const int axes : {1, 3}) {
+    Scenario scenario = loadScenarioFile(testing::scenarioPath("paper_run2.yaml"));
+    if (axes > 1) {
+      scenario = embedAlongDirection(scenario, Eigen::VectorXd::Ones(axes));
+    }
+    scenario.duration = 30.0;
+    const long before_short = testing::allocationCount();
+    const double short_peak = simulate(scenario).max_xi;
+    const long short_run = testing::allocationCount() - before_short;
+    scenario.duration = 60.0;
+    const long before_long = testing::allocationCount();
+    const double long_peak = simulate(scenario).max_xi;
+    const long long_run = testing::allocationCount() - before_long;
+    EXPECT_EQ(long_run, short_run) << axes << " axes";
+    EXPECT_GT(long_peak, short_peak);  // the push at 20-23 s is in both; the peak follows it
+  }
 }
 
 }  // namespace

@@ -1,0 +1,150 @@
+#pragma once
+
+#include <stdexcept>
+
+#include "projection_collision_avoidance/BallConstraint.hpp"
+#include "projection_collision_avoidance/ControllerDesign.hpp"
+#include "projection_collision_avoidance/ProjectionOperator.hpp"
+#include "projection_collision_avoidance/TypeDefs.hpp"
+
+namespace projection_collision_avoidance {
+
+/// The state of the paper's pair in continuous time: z = [x_1; x_2; xi_hat].
+template <typename Dims>
+struct ContinuousLoopState {
+  typename Dims::StateVector leader;    ///< x_1 (m, m/s for a double integrator)
+  typename Dims::StateVector follower;  ///< x_2
+  typename Dims::StateVector estimate;  ///< xi_hat (m, m/s)
+};
+
+/// The signals of the continuous loop at one instant.
+template <typename Dims>
+struct ContinuousLoopSignals {
+  typename Dims::StateVector relative_error;  ///< xi = x_1 - x_2 - d
+  typename Dims::InputVector baseline;        ///< G y (2)
+  typename Dims::InputVector tracker;         ///< u_a (19)
+  typename Dims::InputVector command;         ///< u_2 = sat(G y + u_a + u_ff) (10)
+  double constraint_value = 0.0;              ///< f(xi_hat) (13)
+  bool projection_active = false;             ///< Proj changed the estimator's drift (15)
+};
+
+/// The closed loop of the paper's pair with the laws acting at every instant (no sampling),
+/// the model of its Sec. IV:
+///   x_1' = A x_1 + B u_1 + u_d,   x_2' = A x_2 + B u_2,   u_2 = sat(G y + u_a + u_ff) (10),
+///   u_a = G_e (y - C xi_hat) + S_21 C xi_hat (19),
+///   xi_hat' = Proj(h),  h = A_c xi_hat - B u_a + L (C xi_hat - y) [+ B (a_1 - u_ff)] (11)-(15),
+/// with y = C (x_1 - x_2 - d), a_1 = u_1 [+ pinv(B) u_d] and u_ff = a_1 as configured by
+/// controller.leader_information (else 0), and Proj the Gamma^-1-weighted operator of the notes.
+/// sat() is the controller's: none unless controller.acceleration_limit is set. The same
+/// equations as FollowerController, except that u_a and y are not held over a period.
+template <typename Dims>
+class ContinuousClosedLoop {
+ public:
+  using StateVector = typename Dims::StateVector;
+  using InputVector = typename Dims::InputVector;
+  using OutputVector = typename Dims::OutputVector;
+  using State = ContinuousLoopState<Dims>;
+  using Signals = ContinuousLoopSignals<Dims>;
+
+  /// @param design validated parameters whose sizes fit Dims (std::invalid_argument otherwise)
+  explicit ContinuousClosedLoop(const ControllerDesign& design)
+      : constraint_(design.xi_max, design.parameters.epsilon),
+        acceleration_limit_(design.parameters.acceleration_limit),
+        tracker_enabled_(design.parameters.tracker_enabled),
+        share_disturbance_(design.parameters.leader_disturbance_shared),
+        in_command_(design.parameters.leader_input_in_command),
+        in_estimator_(design.parameters.leader_input_in_estimator) {
+    const AgentModel& model = design.parameters.model;
+    const Eigen::Index n = model.stateDimension();
+    const Eigen::Index m = model.inputDimension();
+    const Eigen::Index p = model.outputDimension();
+    if ((Dims::kStates != Eigen::Dynamic && Dims::kStates != n) ||
+        (Dims::kInputs != Eigen::Dynamic && Dims::kInputs != m) ||
+        (Dims::kOutputs != Eigen::Dynamic && Dims::kOutputs != p) || n > Dims::kMaxStates ||
+        m > Dims::kMaxInputs || p > Dims::kMaxOutputs) {
+      throw std::invalid_argument("ContinuousClosedLoop: model sizes do not fit the dimensions");
+    }
+    state_matrix_ = model.A;
+    input_matrix_ = model.B;
+    output_matrix_ = model.C;
+    separation_ = design.parameters.separation;
+    baseline_gain_ = design.parameters.baseline_gain;
+    tracker_gain_ = design.parameters.tracker_gain;
+    reference_gain_ = design.parameters.reference_gain;
+    estimator_matrix_ = design.estimator_matrix;
+    observer_gain_ = design.parameters.estimator_gain;
+    gamma_inverse_ = design.gamma_inverse;
+    input_pseudoinverse_ = design.input_pseudoinverse;
+  }
+
+  /// z' at one instant, and the loop's signals there. Allocates no memory.
+  /// @param z the state
+  /// @param leader_input u_1 (m/s^2 for a double integrator)
+  /// @param disturbance u_d (position-rate part m/s, velocity-rate part m/s^2)
+  /// @param[out] derivative z'
+  /// @param[out] signals the signals at z (may be null)
+  void evaluate(const State& z, const InputVector& leader_input, const StateVector& disturbance,
+                State* derivative, Signals* signals = nullptr) const {
+    const StateVector xi = z.leader - z.follower - separation_;
+    const OutputVector y = output_matrix_ * xi;
+    const OutputVector estimated_output = output_matrix_ * z.estimate;
+    InputVector tracker = InputVector::Zero(input_matrix_.cols());
+    if (tracker_enabled_) {
+      tracker = tracker_gain_ * (y - estimated_output) + reference_gain_ * estimated_output;
+    }
+    InputVector acceleration = leader_input;  // a_1
+    if (share_disturbance_) {
+      acceleration += input_pseudoinverse_ * disturbance;
+    }
+    InputVector feedforward = InputVector::Zero(input_matrix_.cols());
+    if (in_command_) {
+      feedforward = acceleration;
+    }
+    const InputVector baseline = baseline_gain_ * y;
+    InputVector command = baseline + tracker + feedforward;
+    clampNorm(command, acceleration_limit_);
+
+    // h = (A_c + L C) xi_hat - L y - B u_a = A_c xi_hat - B u_a + L (C xi_hat - y)
+    StateVector drift =
+        estimator_matrix_ * z.estimate - observer_gain_ * y - input_matrix_ * tracker;
+    if (in_estimator_) {
+      drift += input_matrix_ * (acceleration - feedforward);
+    }
+    bool active = false;
+    derivative->estimate = projectDrift(constraint_, z.estimate, drift, gamma_inverse_, &active);
+    derivative->leader = state_matrix_ * z.leader + input_matrix_ * leader_input + disturbance;
+    derivative->follower = state_matrix_ * z.follower + input_matrix_ * command;
+    if (signals != nullptr) {
+      signals->relative_error = xi;
+      signals->baseline = baseline;
+      signals->tracker = tracker;
+      signals->command = command;
+      signals->constraint_value = constraint_.value(z.estimate);
+      signals->projection_active = active;
+    }
+  }
+
+  /// The constraint f of (13) on xi_hat.
+  const BallConstraint& constraint() const { return constraint_; }
+
+ private:
+  BallConstraint constraint_;
+  double acceleration_limit_;
+  bool tracker_enabled_;
+  bool share_disturbance_;
+  bool in_command_;
+  bool in_estimator_;
+  typename Dims::StateMatrix state_matrix_;             // A
+  typename Dims::InputMatrix input_matrix_;             // B
+  typename Dims::OutputMatrix output_matrix_;           // C
+  StateVector separation_;                              // d
+  typename Dims::FeedbackGainMatrix baseline_gain_;     // G
+  typename Dims::FeedbackGainMatrix tracker_gain_;      // G_e
+  typename Dims::FeedbackGainMatrix reference_gain_;    // S_21
+  typename Dims::StateMatrix estimator_matrix_;         // A_c + L C
+  typename Dims::ObserverGainMatrix observer_gain_;     // L
+  typename Dims::StateMatrix gamma_inverse_;            // Gamma^-1
+  typename Dims::StateGainMatrix input_pseudoinverse_;  // pinv(B)
+};
+
+}  // namespace projection_collision_avoidance

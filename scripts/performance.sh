@@ -1,0 +1,88 @@
+#!/usr/bin/env bash
+# Every performance figure of README.md, side by side in one run:
+#   1. Google Benchmark: one control step in 1-D, 2-D, 3-D (inside the bound and held on it by
+#      the projection), heap allocations and flops per step; whole Run 2 in process;
+#   2. callgrind: instructions per control step (load-independent);
+#   3. cf_sim against the SciPy LSODA reference, whole processes (scripts/solver_comparison.py);
+#   4. the ROS follower at 1 kHz on real time next to a bare roscpp relay
+#      (scripts/ros_latency.sh), unless --skip-ros;
+#   5. platoon scale: scripts/formation_scale.sh with --with-scale (18 min), else the figures of
+#      its last run in doc/formation_scale.md.
+# Writes doc/performance.md and the table between the performance markers of README.md.
+# Usage: scripts/performance.sh [--reps N] [--ros-runs N] [--ros-duration S] [--skip-ros]
+#                               [--with-scale] [--no-readme]
+set -euo pipefail
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+build_dir=${BUILD_DIR:-$root/build}
+reps=10
+ros_runs=3
+ros_duration=60
+skip_ros=0
+with_scale=0
+update_readme=1
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --reps) reps=$2; shift 2 ;;
+    --ros-runs) ros_runs=$2; shift 2 ;;
+    --ros-duration) ros_duration=$2; shift 2 ;;
+    --skip-ros) skip_ros=1; shift ;;
+    --with-scale) with_scale=1; shift ;;
+    --no-readme) update_readme=0; shift ;;
+    *) echo "usage: $0 [--reps N] [--ros-runs N] [--ros-duration S] [--skip-ros] [--with-scale] [--no-readme]" >&2
+       exit 2 ;;
+  esac
+done
+
+BUILD_DIR=$build_dir "$root/scripts/build.sh" >/dev/null
+bin=$build_dir/devel/lib/projection_collision_avoidance
+for tool in benchmark_follower_step step_instructions cf_sim; do
+  test -x "$bin/$tool" || { echo "$tool was not built (libbenchmark-dev installed?)" >&2; exit 1; }
+done
+command -v valgrind >/dev/null || { echo "valgrind is needed for the instruction counts" >&2; exit 1; }
+
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+
+echo "== 1/5 Google Benchmark ($reps repetitions)" >&2
+"$bin/benchmark_follower_step" --benchmark_repetitions="$reps" \
+  --benchmark_report_aggregates_only=true --benchmark_format=json >"$work/benchmark.json"
+
+echo "== 2/5 callgrind instructions per step" >&2
+: >"$work/instructions.csv"
+for axes in 1 2 3; do
+  for regime in inside outside; do
+    counts=()
+    for steps in 1000 11000; do
+      valgrind --tool=callgrind --callgrind-out-file="$work/callgrind.out" \
+        "$bin/step_instructions" "$axes" "$steps" "$regime" >/dev/null 2>"$work/callgrind.log"
+      counts+=("$(sed -n 's/.*Collected : \([0-9]*\).*/\1/p' "$work/callgrind.log")")
+    done
+    echo "$axes,$regime,${counts[0]},${counts[1]}" >>"$work/instructions.csv"
+  done
+done
+
+echo "== 3/5 cf_sim against SciPy LSODA ($reps repetitions)" >&2
+/usr/bin/python3 "$root/scripts/solver_comparison.py" --cf-sim "$bin/cf_sim" --reps "$reps" \
+  --json "$work/solvers.json" >/dev/null
+
+ros_args=()
+if [ "$skip_ros" = 0 ]; then
+  echo "== 4/5 ROS follower at 1 kHz ($ros_runs runs of $ros_duration s per setting)" >&2
+  bash "$root/scripts/ros_latency.sh" --runs "$ros_runs" --duration "$ros_duration" \
+    --csv "$work/ros_latency.csv" >/dev/null
+  ros_args=(--ros-csv "$work/ros_latency.csv")
+fi
+
+if [ "$with_scale" = 1 ]; then
+  echo "== 5/5 platoon scale (scripts/formation_scale.sh)" >&2
+  bash "$root/scripts/formation_scale.sh" >/dev/null
+fi
+
+readme_args=()
+if [ "$update_readme" = 1 ]; then
+  readme_args=(--readme "$root/README.md")
+fi
+/usr/bin/python3 "$root/scripts/performance_report.py" --benchmark "$work/benchmark.json" \
+  --instructions "$work/instructions.csv" --solvers "$work/solvers.json" "${ros_args[@]}" \
+  --scale "$root/doc/formation_scale.md" --reps "$reps" --out "$root/doc/performance.md" \
+  "${readme_args[@]}"

@@ -1,0 +1,225 @@
+#include "projection_collision_avoidance/ContinuousSimulator.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "projection_collision_avoidance/ContinuousClosedLoop.hpp"
+#include "projection_collision_avoidance/ControllerDesign.hpp"
+#include "projection_collision_avoidance/DimensionDispatch.hpp"
+#include "projection_collision_avoidance/Formation.hpp"
+#include "projection_collision_avoidance/ParameterError.hpp"
+
+namespace projection_collision_avoidance {
+namespace {
+
+/// @p v (n entries) as a vector of the bounded type, copied entry by entry.
+template <typename Vector>
+Vector toBounded(const Eigen::VectorXd& v) {
+  Vector result = Vector::Zero(v.size());
+  for (Eigen::Index i = 0; i < result.size(); ++i) {
+    result(i) = v(i);
+  }
+  return result;
+}
+
+template <typename Dims>
+class ContinuousRun {
+ public:
+  using StateVector = typename Dims::StateVector;
+  using InputVector = typename Dims::InputVector;
+  using State = ContinuousLoopState<Dims>;
+  using Signals = ContinuousLoopSignals<Dims>;
+
+  ContinuousRun(const Scenario& scenario, const ControllerDesign& design)
+      : scenario_(scenario),
+        design_(design),
+        loop_(design),
+        inputs_(design.parameters.model.inputDimension()),
+        states_(design.parameters.model.stateDimension()),
+        positions_(design.parameters.model.position_dimension),
+        radius_(design.xi_max * (1.0 - 16.0 * std::numeric_limits<double>::epsilon())) {}
+
+  /// u_1 at time t with the pulses taken at @p pulse_time.
+  InputVector leaderInput(double t, double pulse_time) const {
+    InputVector u1 = InputVector::Zero(inputs_);
+    scenario_.leader_input.addPulsesTo(pulse_time, u1);
+    scenario_.leader_input.addSinusoidsTo(t, u1);
+    return u1;
+  }
+
+  /// u_d at time t with the pulses taken at @p pulse_time.
+  StateVector disturbance(double t, double pulse_time) const {
+    StateVector ud = StateVector::Zero(states_);
+    scenario_.disturbance.addPulsesTo(pulse_time, ud);
+    scenario_.disturbance.addSinusoidsTo(t, ud);
+    return ud;
+  }
+
+  /// One RK4 step of z from a to b, the pulses taken at the middle of [a, b].
+  void rk4(double a, double b, State* z) const {
+    const double h = b - a;
+    const double middle = 0.5 * (a + b);
+    const StateVector ud = disturbance(middle, middle);
+    const bool varying = scenario_.leader_input.hasSinusoids();
+    const InputVector u1_start = leaderInput(a, middle);
+    const InputVector u1_middle = varying ? leaderInput(middle, middle) : u1_start;
+    const InputVector u1_end = varying ? leaderInput(b, middle) : u1_start;
+    State k1;
+    State k2;
+    State k3;
+    State k4;
+    State stage;
+    loop_.evaluate(*z, u1_start, ud, &k1);
+    axpy(*z, 0.5 * h, k1, &stage);
+    loop_.evaluate(stage, u1_middle, ud, &k2);
+    axpy(*z, 0.5 * h, k2, &stage);
+    loop_.evaluate(stage, u1_middle, ud, &k3);
+    axpy(*z, h, k3, &stage);
+    loop_.evaluate(stage, u1_end, ud, &k4);
+    const double sixth = h / 6.0;
+    z->leader += sixth * (k1.leader + 2.0 * k2.leader + 2.0 * k3.leader + k4.leader);
+    z->follower += sixth * (k1.follower + 2.0 * k2.follower + 2.0 * k3.follower + k4.follower);
+    z->estimate += sixth * (k1.estimate + 2.0 * k2.estimate + 2.0 * k3.estimate + k4.estimate);
+  }
+
+  SimulationSummary run(double step, const SampleObserver& observer) {
+    const ControllerParameters& p = scenario_.controller;
+    const FormationMember member =
+        layoutFormation(scenario_.formation, p.separation, scenario_.leader_initial_state,
+                        scenario_.follower_initial_state)
+            .front();
+    State z;
+    z.leader = toBounded<StateVector>(scenario_.leader_initial_state);
+    z.follower = toBounded<StateVector>(member.initial_state);
+    z.estimate = StateVector::Zero(states_);
+    if (p.initial_estimate == InitialEstimate::kMeasurement) {
+      const StateVector xi0 = z.leader - z.follower - toBounded<StateVector>(member.separation);
+      const typename Dims::ObserverGainMatrix output_pseudoinverse = design_.output_pseudoinverse;
+      const typename Dims::OutputMatrix output_matrix = p.model.C;
+      z.estimate = output_pseudoinverse * (output_matrix * xi0);
+      clampNorm(z.estimate, radius_);
+    }
+
+    SimulationSummary summary;
+    summary.xi_max = loop_.constraint().hardRadius();
+    summary.perimeter = design_.perimeter;
+    summary.min_separation = std::numeric_limits<double>::infinity();
+    const long last_tick = std::lround(scenario_.duration / step);
+    const double tolerance = 1e-9 * step;
+    for (long tick = 0; tick <= last_tick; ++tick) {
+      const double t = static_cast<double>(tick) * step;
+      record(t, z, step, observer, &summary);
+      if (tick == last_tick) {
+        break;
+      }
+      const double t_end = static_cast<double>(tick + 1) * step;
+      if (!scenario_.leader_input.hasEdgeWithin(t + tolerance, t_end - tolerance) &&
+          !scenario_.disturbance.hasEdgeWithin(t + tolerance, t_end - tolerance)) {
+        rk4(t, t_end, &z);
+      } else {
+        std::vector<double> edges =
+            scenario_.leader_input.edgesWithin(t + tolerance, t_end - tolerance);
+        const std::vector<double> more =
+            scenario_.disturbance.edgesWithin(t + tolerance, t_end - tolerance);
+        edges.insert(edges.end(), more.begin(), more.end());
+        std::sort(edges.begin(), edges.end());
+        double a = t;
+        for (const double edge : edges) {
+          if (edge > a) {
+            rk4(a, edge, &z);
+            a = edge;
+          }
+        }
+        rk4(a, t_end, &z);
+      }
+      const double norm = clampNorm(z.estimate, radius_);
+      if (norm > 0.0) {
+        summary.max_boundary_correction = std::max(summary.max_boundary_correction, norm - radius_);
+      }
+    }
+    return summary;
+  }
+
+ private:
+  static void axpy(const State& z, double a, const State& k, State* result) {
+    result->leader = z.leader + a * k.leader;
+    result->follower = z.follower + a * k.follower;
+    result->estimate = z.estimate + a * k.estimate;
+  }
+
+  void record(double t, const State& z, double step, const SampleObserver& observer,
+              SimulationSummary* summary) const {
+    const StateVector xi = z.leader - z.follower - design_.parameters.separation;
+    const double xi_norm = xi.norm();
+    double squared = 0.0;  // ||p_1 - p_2||^2 over the position entries
+    for (int i = 0; i < positions_; ++i) {
+      squared += (z.leader(i) - z.follower(i)) * (z.leader(i) - z.follower(i));
+    }
+    const double separation = std::sqrt(squared);
+    summary->max_xi = std::max(summary->max_xi, xi_norm);
+    summary->max_xi_hat = std::max(summary->max_xi_hat, z.estimate.norm());
+    summary->min_separation = std::min(summary->min_separation, separation);
+    if (xi_norm > summary->xi_max) {
+      summary->time_outside += step;
+    }
+    ++summary->ticks;
+    if (!observer) {
+      return;
+    }
+    const InputVector u1 = leaderInput(t, t);
+    const StateVector ud = disturbance(t, t);
+    State derivative;
+    Signals signals;
+    loop_.evaluate(z, u1, ud, &derivative, &signals);
+    SimulationSample sample;
+    sample.time = t;
+    sample.relative_error = xi;
+    sample.estimate = z.estimate;
+    sample.constraint_value = signals.constraint_value;
+    sample.projection_active = signals.projection_active;
+    sample.leader_state = z.leader;
+    sample.follower_state = z.follower;
+    sample.separation = separation;
+    sample.command = signals.command;
+    sample.baseline_command = signals.baseline;
+    sample.tracker_command = signals.tracker;
+    sample.leader_input = u1;
+    sample.disturbance = ud;
+    observer(sample);
+  }
+
+  const Scenario& scenario_;
+  const ControllerDesign& design_;
+  ContinuousClosedLoop<Dims> loop_;
+  Eigen::Index inputs_;
+  Eigen::Index states_;
+  int positions_;
+  double radius_;
+};
+
+}  // namespace
+
+SimulationSummary simulateContinuous(const Scenario& scenario, double step,
+                                     const SampleObserver& observer) {
+  const ControllerDesign design = ControllerDesign::create(scenario.controller);
+  scenario.validate();
+  if (scenario.formation.followers != 1) {
+    throw ParameterError("formation.followers",
+                         "the continuous-time loop runs the pair (one follower)");
+  }
+  if (!(std::isfinite(step) && step > 0.0 && step <= scenario.duration)) {
+    throw ParameterError("step", "must be finite, > 0 and at most simulation.duration");
+  }
+  const double steps = scenario.duration / step;
+  if (std::abs(steps - std::round(steps)) > 1e-9 * std::max(1.0, steps)) {
+    throw ParameterError("step", "must divide simulation.duration into a whole number of steps");
+  }
+  return visitDimensions(scenario.controller.model, [&](auto dims) {
+    ContinuousRun<decltype(dims)> run(scenario, design);
+    return run.run(step, observer);
+  });
+}
+
+}  // namespace projection_collision_avoidance

@@ -1,0 +1,144 @@
+/// The continuous-time loop (ContinuousClosedLoop, simulateContinuous()): the paper's figures,
+/// fourth-order convergence of RK4, the invariance of Omega_1, and the sampled controller
+/// converging to it at first order in the period.
+
+#include <cmath>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "projection_collision_avoidance/ClosedLoopSimulator.hpp"
+#include "projection_collision_avoidance/ContinuousClosedLoop.hpp"
+#include "projection_collision_avoidance/ContinuousSimulator.hpp"
+#include "projection_collision_avoidance/ParameterError.hpp"
+#include "projection_collision_avoidance/ScenarioEmbedding.hpp"
+#include "projection_collision_avoidance/ScenarioLoader.hpp"
+
+#include "TestScenarios.hpp"
+
+namespace projection_collision_avoidance {
+namespace {
+
+using testing::scenarioPath;
+
+/// The samples of a run at the times of the 100 Hz grid.
+std::vector<SimulationSample> onGrid(const std::vector<SimulationSample>& samples, double step) {
+  std::vector<SimulationSample> result;
+  const long every = std::lround(0.01 / step);
+  for (std::size_t k = 0; k < samples.size(); k += static_cast<std::size_t>(every)) {
+    result.push_back(samples[k]);
+  }
+  return result;
+}
+
+std::vector<SimulationSample> continuousRun(const Scenario& scenario, double step) {
+  std::vector<SimulationSample> samples;
+  simulateContinuous(scenario, step, [&](const SimulationSample& s) { samples.push_back(s); });
+  return onGrid(samples, step);
+}
+
+/// max over the common grid of ||xi - xi_ref|| and ||xi_hat - xi_hat_ref||.
+double largestDifference(const std::vector<SimulationSample>& a,
+                         const std::vector<SimulationSample>& b) {
+  EXPECT_EQ(a.size(), b.size());
+  double largest = 0.0;
+  for (std::size_t k = 0; k < std::min(a.size(), b.size()); ++k) {
+    EXPECT_NEAR(a[k].time, b[k].time, 1e-9);
+    largest = std::max(largest, (a[k].relative_error - b[k].relative_error).norm());
+    largest = std::max(largest, (a[k].estimate - b[k].estimate).norm());
+  }
+  return largest;
+}
+
+TEST(ContinuousSimulator, Run2MatchesThePapersFigures) {
+  const Scenario scenario = loadScenarioFile(scenarioPath("paper_run2.yaml"));
+  const SimulationSummary s = simulateContinuous(scenario, 0.005);
+  EXPECT_LT(s.max_xi, s.xi_max);
+  EXPECT_NEAR(s.max_xi, 3.0, 0.15);
+  EXPECT_NEAR(s.min_separation, 3.9, 0.1);
+  EXPECT_EQ(s.time_outside, 0.0);
+  EXPECT_LE(s.max_xi_hat, s.xi_max);
+  EXPECT_EQ(s.ticks, 12001);
+}
+
+TEST(ContinuousSimulator, Run1LeavesTheBoundWhileTheEstimateStaysInside) {
+  const Scenario scenario = loadScenarioFile(scenarioPath("paper_run1.yaml"));
+  std::vector<SimulationSample> samples;
+  const SimulationSummary s = simulateContinuous(
+      scenario, 0.005, [&](const SimulationSample& sample) { samples.push_back(sample); });
+  EXPECT_NEAR(s.max_xi, 5.2, 0.1);
+  EXPECT_NEAR(s.min_separation, 0.1, 0.05);
+  EXPECT_GT(s.max_xi_hat, 0.999 * s.xi_max);  // the estimate rides the bound
+  bool projected = false;
+  for (const SimulationSample& sample : samples) {
+    ASSERT_LE(sample.estimate.norm(), s.xi_max) << "t=" << sample.time;
+    projected = projected || sample.projection_active;
+  }
+  EXPECT_TRUE(projected);
+  // The projection keeps the exact solution in Omega_1; RK4 leaves it by next to nothing.
+  EXPECT_LT(s.max_boundary_correction, 1e-9);
+}
+
+// Halving the step divides the error by about 2^4 = 16 while it is above rounding.
+TEST(ContinuousSimulator, ConvergesAtFourthOrder) {
+  for (const char* name : {"paper_run1.yaml", "paper_run2.yaml"}) {
+    const Scenario scenario = loadScenarioFile(scenarioPath(name));
+    const std::vector<SimulationSample> fine = continuousRun(scenario, 0.000625);
+    const double coarse_error = largestDifference(continuousRun(scenario, 0.01), fine);
+    const double half_error = largestDifference(continuousRun(scenario, 0.005), fine);
+    EXPECT_GT(coarse_error, 1e-10) << name;  // far above the fine run's own error
+    EXPECT_GT(coarse_error / half_error, 10.0)
+        << name << ": " << coarse_error << " then " << half_error;
+  }
+}
+
+// The sampled controller (zero-order hold) approaches the continuous loop as the rate grows,
+// at first order: within a few centimetres at 100 Hz and a few millimetres at 1 kHz (the
+// math note).
+TEST(ContinuousSimulator, SampledControllerConvergesToIt) {
+  Scenario scenario = loadScenarioFile(scenarioPath("paper_run2.yaml"));
+  const std::vector<SimulationSample> continuous = continuousRun(scenario, 0.002);
+  std::vector<double> errors;
+  for (const double rate : {100.0, 1000.0}) {
+    scenario.controller.control_rate = rate;
+    std::vector<SimulationSample> samples;
+    simulate(scenario, [&](const SimulationSample& s) { samples.push_back(s); });
+    errors.push_back(largestDifference(onGrid(samples, 1.0 / rate), continuous));
+  }
+  EXPECT_LT(errors[0], 0.06);
+  EXPECT_LT(errors[1], 0.006);
+  EXPECT_NEAR(errors[0] / errors[1], 10.0, 1.5);
+}
+
+TEST(ContinuousSimulator, ThreeAxesAlongADiagonalIsTheOneAxisRun) {
+  const Scenario one = loadScenarioFile(scenarioPath("paper_run2.yaml"));
+  const Scenario three = embedAlongDirection(one, Eigen::Vector3d(1.0, 2.0, -2.0));
+  const SimulationSummary a = simulateContinuous(one, 0.005);
+  const SimulationSummary b = simulateContinuous(three, 0.005);
+  EXPECT_NEAR(a.max_xi, b.max_xi, 1e-9);
+  EXPECT_NEAR(a.max_xi_hat, b.max_xi_hat, 1e-9);
+  EXPECT_NEAR(a.min_separation, b.min_separation, 1e-9);
+}
+
+TEST(ContinuousSimulator, RefusesBadStepsAndFormations) {
+  Scenario scenario = loadScenarioFile(scenarioPath("paper_run2.yaml"));
+  for (const double step : {0.0, -0.01, std::nan(""), 0.007, 120.0}) {
+    try {
+      simulateContinuous(scenario, step);
+      ADD_FAILURE() << "step " << step << " accepted";
+    } catch (const ParameterError& error) {
+      EXPECT_EQ(error.key(), "step");
+    }
+  }
+  scenario.formation.followers = 2;
+  scenario.formation.configured = true;
+  try {
+    simulateContinuous(scenario, 0.01);
+    ADD_FAILURE() << "a formation accepted";
+  } catch (const ParameterError& error) {
+    EXPECT_EQ(error.key(), "formation.followers");
+  }
+}
+
+}  // namespace
+}  // namespace projection_collision_avoidance
