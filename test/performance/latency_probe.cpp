@@ -21,6 +21,9 @@
 /// (ros::MessageEvent::getReceiptTime()), so that the probe's own callback queue does not count;
 /// the time at the callback is reported too ("callback_latency_us").
 ///
+/// publish() writes to the subscribers of relative_measurement one after the other, in the order
+/// they connected ("send_order" in the JSON), so the later ones get their copy a little later.
+///
 /// Only measurements published in the measured window count (by their stamps). Writes ~output
 /// (JSON): per stream published/received counts and latency p50/p90/p99/max in microseconds; per
 /// follower ticks, missed_periods and late_periods within the window (the status at the window's
@@ -171,7 +174,11 @@ class LatencyProbe {
 
     const ros::TransportHints hints = ros::TransportHints().tcpNoDelay();
     const uint32_t queue = 1000;
-    publisher_ = nh_.advertise<RelativeMeasurement>("relative_measurement", 10);
+    publisher_ = nh_.advertise<RelativeMeasurement>(
+        "relative_measurement", 10, [this](const ros::SingleSubscriberPublisher& subscriber) {
+          const std::lock_guard<std::mutex> lock(order_mutex_);
+          send_order_.push_back(subscriber.getSubscriberName());
+        });
     subscribers_.push_back(
         nh_.subscribe("relay_output", queue, &LatencyProbe::onRelay, this, hints));
     subscribers_.push_back(nh_.subscribe("measurement_command", queue,
@@ -407,6 +414,15 @@ class LatencyProbe {
            ", \"late_periods\": " + std::to_string(final_status.late_periods) + "}}";
   }
 
+  std::string sendOrder() {
+    const std::lock_guard<std::mutex> lock(order_mutex_);
+    std::string text = "[";
+    for (const std::string& name : send_order_) {
+      text += (text.size() > 1 ? ", \"" : "\"") + name + "\"";
+    }
+    return text + "]";
+  }
+
   int report() {
     std::size_t relay_received = 0;
     std::size_t measurement_received = 0;
@@ -436,8 +452,8 @@ class LatencyProbe {
         ",\n  \"probe\": {\"published\": " + std::to_string(published_) +
         ", \"skipped_periods\": " + std::to_string(skipped_) +
         ", \"publish_delay_us\": " + json(delay) +
-        ", \"recorder_overflow\": " + std::to_string(overflow) + "}" +
-        ",\n  \"streams\": {\n    \"relay\": " + relay +
+        ", \"recorder_overflow\": " + std::to_string(overflow) +
+        ", \"send_order\": " + sendOrder() + "}" + ",\n  \"streams\": {\n    \"relay\": " + relay +
         ",\n    \"follower_measurement\": " + measurement + ",\n    \"follower_timer\": " + timer +
         "\n  },\n  \"followers\": {\n    \"follower_measurement\": " + measurement_follower +
         ",\n    \"follower_timer\": " + timer_follower + "\n  }\n}\n";
@@ -481,6 +497,10 @@ class LatencyProbe {
 
   ros::Publisher publisher_;
   std::vector<ros::Subscriber> subscribers_;
+  /// The subscribers of relative_measurement in the order they connected: the order in which
+  /// publish() writes to them (each write delays the next subscriber's copy a little).
+  std::mutex order_mutex_;
+  std::vector<std::string> send_order_;
   // Written by the publishing thread, read after it is joined.
   std::uint64_t published_ = 0;
   std::uint64_t skipped_ = 0;
