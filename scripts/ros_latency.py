@@ -77,7 +77,7 @@ def run_one(args, setting, index):
     command = ["roslaunch", "-p", str(args.port), LAUNCH, "duration:=%g" % args.duration,
                "rate:=%g" % args.rate, "control_rate:=%g" % args.rate, "output:=%s" % output]
     row = {"setting": setting, "run": index, "duration_s": args.duration, "rate_hz": args.rate,
-           "load1_before": loadavg(), "ok": False, "json": output}
+           "load1_before": loadavg(), "ok": False}
     total0, steal0 = cpu_times()
     started = time.time()
     with open(launch_log, "w") as out:
@@ -232,7 +232,9 @@ def table(rows, args):
         "were due (measurement-triggered: after the measurement's stamp). Percentages of "
         "duration x rate. The probe writes each measurement to the relay and the followers one "
         "after the other, in the order they connected (CSV column send_order), and the three "
-        "share two cores: the order alone moves a receiver's latency by tens of µs.",
+        "share two cores: the order alone moves a receiver's latency by tens of µs. The load "
+        "average is the 1-minute one before each run (with keep-awake it includes the busy "
+        "loops, one per core).",
         ""]
     lines += ["- " + v for v in verdicts]
     return "\n".join(lines)
