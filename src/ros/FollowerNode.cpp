@@ -1,7 +1,9 @@
 #include "projection_collision_avoidance/ros/FollowerNode.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <iomanip>
+#include <limits>
 #include <sstream>
 
 #include <geometry_msgs/AccelStamped.h>
@@ -30,6 +32,35 @@ FormationMember memberOf(NodeOptionReader& reader, const Scenario& scenario) {
   return members[static_cast<std::size_t>(index - 1)];
 }
 
+/// Control periods skipped between two consecutive due times @p gap s apart: none up to 1.5
+/// periods, else round(gap / period) - 1.
+std::uint32_t skippedPeriods(double gap, double period) {
+  if (!(gap > 1.5 * period)) {
+    return 0;
+  }
+  const double skipped = std::round(gap / period) - 1.0;
+  return skipped >= static_cast<double>(std::numeric_limits<std::uint32_t>::max())
+             ? std::numeric_limits<std::uint32_t>::max()
+             : static_cast<std::uint32_t>(skipped);
+}
+
+/// Adds without wrapping around.
+void addSaturated(std::uint32_t* counter, std::uint32_t amount) {
+  *counter = *counter > std::numeric_limits<std::uint32_t>::max() - amount
+                 ? std::numeric_limits<std::uint32_t>::max()
+                 : *counter + amount;
+}
+
+ControlTrigger triggerOf(const std::string& value) {
+  if (value == "timer") {
+    return ControlTrigger::kTimer;
+  }
+  if (value == "measurement") {
+    return ControlTrigger::kMeasurement;
+  }
+  throw ParameterError("~trigger", "must be \"timer\" or \"measurement\", got \"" + value + "\"");
+}
+
 FollowerNodeOptions readOptions(NodeOptionReader& reader, const ControllerParameters& p,
                                 const FormationMember& member) {
   FollowerNodeOptions options;
@@ -48,10 +79,15 @@ FollowerNodeOptions readOptions(NodeOptionReader& reader, const ControllerParame
     throw ParameterError("~follower_frame", "must not be empty");
   }
   options.marker_rate = reader.number("marker_rate", options.marker_rate, 0.0, p.control_rate);
+  options.trigger = triggerOf(reader.text("trigger", toString(options.trigger)));
   return options;
 }
 
 }  // namespace
+
+const char* toString(ControlTrigger trigger) {
+  return trigger == ControlTrigger::kMeasurement ? "measurement" : "timer";
+}
 
 FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
     : FollowerNode(nh, private_nh, loadDoubleIntegratorScenario(private_nh)) {}
@@ -78,6 +114,7 @@ FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh, const
   echoScenario(name, private_nh);
   reader.echo(name);
 
+  period_ = 1.0 / parameters_.control_rate;
   relative_state_ = Eigen::VectorXd::Zero(2 * axes_);
   leader_input_ = Eigen::VectorXd::Zero(axes_);
   command_publisher_ = nh_.advertise<geometry_msgs::AccelStamped>("command", 10);
@@ -104,8 +141,9 @@ FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh, const
   control_spinner_->start();
   ROS_INFO_STREAM(name << ": " << member_.name << " looking at " << member_.target_name << ", d = ["
                        << parameters_.separation.transpose() << "], running at "
-                       << parameters_.control_rate << " Hz, " << axes_ << " axes, xi_max "
-                       << controller_.design().xi_max << " m");
+                       << parameters_.control_rate << " Hz (trigger: " << toString(options_.trigger)
+                       << "), " << axes_ << " axes, xi_max " << controller_.design().xi_max
+                       << " m");
 }
 
 FollowerNode::~FollowerNode() {
@@ -115,17 +153,25 @@ FollowerNode::~FollowerNode() {
 
 void FollowerNode::onMeasurement(const RelativeMeasurement::ConstPtr& msg) {
   const std::lock_guard<std::mutex> lock(mutex_);
-  if (!measurement_guard_.checkHeader(msg->header, ros::Time::now())) {
+  const ros::Time now = ros::Time::now();
+  if (!measurement_guard_.checkHeader(msg->header, now)) {
     return;
   }
   std::string why;
-  Eigen::VectorXd state;
-  if (!relativeStateFromMsg(*msg, axes_, &state, &why)) {
+  if (!relativeStateFromMsg(*msg, axes_, &relative_state_, &why)) {
     measurement_guard_.reject(why);
     return;
   }
-  relative_state_ = state;
+  const bool triggered = options_.trigger == ControlTrigger::kMeasurement;
+  if (triggered && measurement_guard_.haveAccepted()) {
+    addSaturated(
+        &missed_periods_,
+        skippedPeriods((msg->header.stamp - measurement_guard_.lastStamp()).toSec(), period_));
+  }
   measurement_guard_.accept(msg->header.stamp);
+  if (triggered) {
+    controlStep(msg->header.stamp, (now - msg->header.stamp).toSec());
+  }
 }
 
 void FollowerNode::onLeaderBroadcast(const LeaderBroadcast::ConstPtr& msg) {
@@ -165,16 +211,42 @@ void FollowerNode::logModeChange(FollowerMode mode) {
   }
 }
 
-void FollowerNode::onControlTick(const ros::TimerEvent& /*event*/) {
+FollowerMode FollowerNode::modeAt(const ros::Time& now, FollowerInputAges* ages) const {
+  ages->have_measurement = measurement_guard_.haveAccepted();
+  ages->measurement_age = (now - measurement_guard_.lastStamp()).toSec();
+  ages->have_leader = leader_guard_.haveAccepted();
+  ages->leader_age = (now - leader_guard_.lastStamp()).toSec();
+  return selectFollowerMode(
+      *ages, FollowerTimeouts{options_.measurement_timeout, options_.leader_timeout});
+}
+
+void FollowerNode::onControlTick(const ros::TimerEvent& event) {
   const std::lock_guard<std::mutex> lock(mutex_);
   const ros::Time now = ros::Time::now();
+  const double delay = (event.current_real - event.current_expected).toSec();
+  if (options_.trigger == ControlTrigger::kTimer) {
+    if (have_last_expected_) {
+      addSaturated(&missed_periods_,
+                   skippedPeriods((event.current_expected - last_expected_).toSec(), period_));
+    }
+    last_expected_ = event.current_expected;
+    have_last_expected_ = true;
+    controlStep(now, delay);
+    return;
+  }
+  // Measurement-triggered: the measurements run the steps while they are fresh; the timer only
+  // brakes once they are stale, and keeps the diagnostics going.
   FollowerInputAges ages;
-  ages.have_measurement = measurement_guard_.haveAccepted();
-  ages.measurement_age = (now - measurement_guard_.lastStamp()).toSec();
-  ages.have_leader = leader_guard_.haveAccepted();
-  ages.leader_age = (now - leader_guard_.lastStamp()).toSec();
-  const FollowerMode mode = selectFollowerMode(
-      ages, FollowerTimeouts{options_.measurement_timeout, options_.leader_timeout});
+  if (modeAt(now, &ages) == FollowerMode::kMeasurementLost) {
+    controlStep(now, delay);
+  } else {
+    diagnostics_.update();
+  }
+}
+
+void FollowerNode::controlStep(const ros::Time& stamp, double delay) {
+  FollowerInputAges ages;
+  const FollowerMode mode = modeAt(stamp, &ages);
   if (mode != mode_) {
     logModeChange(mode);
     mode_ = mode;
@@ -182,6 +254,11 @@ void FollowerNode::onControlTick(const ros::TimerEvent& /*event*/) {
   if (mode == FollowerMode::kWaiting) {
     diagnostics_.update();
     return;
+  }
+  const std::uint64_t tick = ticks_++;
+  tick_delay_ = delay;
+  if (delay > 0.5 * period_) {
+    addSaturated(&late_periods_, 1);
   }
   leader_fresh_ = ages.have_leader && ages.leader_age <= options_.leader_timeout;
   const bool use_leader_input = options_.use_leader_broadcast && leader_fresh_;
@@ -194,22 +271,22 @@ void FollowerNode::onControlTick(const ros::TimerEvent& /*event*/) {
     const Eigen::VectorXd y = parameters_.model.C * xi;
     status = use_leader_input ? &controller_.step(y, leader_input_) : &controller_.step(y);
   }
-  command_publisher_.publish(toAccelMsg(status->command, now, options_.follower_frame));
+  command_publisher_.publish(toAccelMsg(status->command, stamp, options_.follower_frame));
   LeaderBroadcast broadcast;  // for a follower behind this one: its acceleration, no state
-  broadcast.header.stamp = now;
+  broadcast.header.stamp = stamp;
   broadcast.header.frame_id = options_.follower_frame;
   broadcast.input = toStdVector(status->command);
   broadcast_publisher_.publish(broadcast);
   last_xi_norm_ = xi.norm();
-  publishStatus(now, xi, ages.measurement_age);
-  const long ticks_per_marker =
+  publishStatus(stamp, xi, ages.measurement_age);
+  const std::uint64_t ticks_per_marker =
       options_.marker_rate > 0.0
-          ? std::max(1L, std::lround(parameters_.control_rate / options_.marker_rate))
+          ? static_cast<std::uint64_t>(
+                std::max(1L, std::lround(parameters_.control_rate / options_.marker_rate)))
           : 0;
-  if (ticks_per_marker > 0 && ticks_ % ticks_per_marker == 0) {
-    publishMarkers(now, xi);
+  if (ticks_per_marker > 0 && tick % ticks_per_marker == 0) {
+    publishMarkers(stamp, xi);
   }
-  ++ticks_;
   diagnostics_.update();
 }
 
@@ -249,6 +326,10 @@ void FollowerNode::publishStatus(const ros::Time& now, const Eigen::VectorXd& xi
   msg.fallback_command = toStdVector(s.fallback_command);
   msg.separation = relative_state_.head(axes_).norm();
   msg.perimeter = design.perimeter;
+  msg.ticks = ticks_;
+  msg.missed_periods = missed_periods_;
+  msg.late_periods = late_periods_;
+  msg.tick_delay = tick_delay_;
   status_publisher_.publish(msg);
 }
 
@@ -303,7 +384,7 @@ void FollowerNode::publishMarkers(const ros::Time& now, const Eigen::VectorXd& x
 }
 
 void FollowerNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
-  // Called from onControlTick with mutex_ held.
+  // Called from a control step or tick with mutex_ held.
   using diagnostic_msgs::DiagnosticStatus;
   const ControllerDesign& design = controller_.design();
   const RuntimeFollowerStatus& s = controller_.status();
@@ -349,6 +430,11 @@ void FollowerNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
                                         : -1.0);
   status.add("leader_age (s)",
              leader_guard_.haveAccepted() ? (now - leader_guard_.lastStamp()).toSec() : -1.0);
+  status.add("trigger", toString(options_.trigger));
+  status.add("ticks", ticks_);
+  status.add("missed_periods", missed_periods_);
+  status.add("late_periods", late_periods_);
+  status.add("tick_delay (s)", tick_delay_);
 }
 
 FollowerConfig FollowerNode::configOf(const ControllerParameters& parameters) const {

@@ -515,6 +515,11 @@ NODE_OPTIONS = [
     opt("marker_rate < 0", FOLLOWER, "marker_rate", -1.0),
     opt("marker_rate above the control rate", FOLLOWER, "marker_rate", 1e6),
     opt("marker_rate NaN", FOLLOWER, "marker_rate", NAN),
+    opt("trigger unknown", FOLLOWER, "trigger", "sometimes"),
+    opt("trigger empty", FOLLOWER, "trigger", ""),
+    opt("trigger capitalised", FOLLOWER, "trigger", "Timer"),
+    opt("trigger a number", FOLLOWER, "trigger", 1),
+    opt("trigger a boolean", FOLLOWER, "trigger", True),
     # plant_node
     opt("rate < 0", PLANT, "rate", -1.0),
     opt("rate = 0", PLANT, "rate", 0),
@@ -752,6 +757,9 @@ class InvalidParameters(unittest.TestCase):
                  for node in ALL_NODES]
         cases.append(case("2-D", None, scenario=planar))
         cases.append(case("file path", None, scenario=paper_path()))
+        for trigger in ("timer", "measurement"):
+            cases.append(case("trigger " + trigger, None, options={"trigger": trigger},
+                              nodes=(FOLLOWER,)))
         failures = []
         for c, node, r in self.run_cases(cases):
             if r.outcome != "running":

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -23,6 +24,15 @@
 
 namespace projection_collision_avoidance {
 
+/// What runs the follower's control steps (~trigger).
+enum class ControlTrigger : std::uint8_t {
+  kTimer,        ///< "timer": a timer at control_rate, on the latest accepted measurement
+  kMeasurement,  ///< "measurement": each accepted measurement, at once, stamped with its stamp
+};
+
+/// "timer" or "measurement".
+const char* toString(ControlTrigger trigger);
+
 /// The follower node's own options (besides the scenario), read once from its private namespace.
 struct FollowerNodeOptions {
   double measurement_timeout = 0.5;    ///< s; an older measurement puts the follower in fallback
@@ -34,6 +44,8 @@ struct FollowerNodeOptions {
   std::string follower_frame;  ///< frame of the command, status and markers (default: the name)
   double marker_rate = 10.0;   ///< Hz
   int formation_index = 1;     ///< i: which follower of the scenario's formation this is
+  /// ~trigger: "timer" (default) or "measurement"; see FollowerNode.
+  ControlTrigger trigger = ControlTrigger::kTimer;
 };
 
 /// ROS wrapper of RuntimeFollowerController: translates messages and time, nothing else.
@@ -43,7 +55,7 @@ struct FollowerNodeOptions {
 /// a chain). Subscribes `relative_measurement` (RelativeMeasurement, x_target - x_i) and
 /// `leader_broadcast` (LeaderBroadcast of the target: monitored always, its acceleration u_1, plus
 /// pinv(B) u_d with controller.leader_information.disturbance, used with ~use_leader_broadcast).
-/// Every 1 / control_rate s (ROS time) it picks the mode from the inputs' ages
+/// At each control step (see ~trigger below) it picks the mode from the inputs' ages
 /// (selectFollowerMode()): with a fresh measurement it runs the controller on
 /// y = C (x_target - x_i - d_i), with a stale one the braking fallback; then it publishes
 /// `command` (geometry_msgs/AccelStamped), `broadcast` (LeaderBroadcast with that command as
@@ -53,6 +65,21 @@ struct FollowerNodeOptions {
 /// the future or before the last accepted one are refused and counted. dynamic_reconfigure
 /// changes the tracker switch, alpha, epsilon and the tracker gain; a set the controller design
 /// refuses is rejected and the old one kept.
+///
+/// ~trigger decides what runs a control step. "timer" (default): a timer every 1 / control_rate s
+/// (ROS time), on the latest accepted measurement; the step is stamped with the timer's time, so
+/// a measurement waits up to one period. "measurement": every accepted measurement runs one step
+/// at once, inside its callback, stamped with the measurement's header.stamp (the command then
+/// carries the stamp of the measurement it answers). The timer still runs at control_rate, but
+/// steps only once the measurement is stale (the braking fallback); otherwise it only updates
+/// the diagnostics. The estimator integrates one period per step either way, so measurements are
+/// expected at control_rate.
+///
+/// Period accounting (status and diagnostics): ticks (steps run), missed_periods ("timer":
+/// periods the timer skipped, its expected times more than 1.5 periods apart counting
+/// round(gap / T) - 1; "measurement": the same on the stamps of consecutive accepted
+/// measurements), late_periods (steps that started more than T / 2 after they were due: the
+/// timer's expected time, or the measurement's stamp) and tick_delay (start - due time).
 class FollowerNode {
  public:
   /// @throws ParameterError naming the parameter when the scenario or an option is invalid
@@ -65,6 +92,11 @@ class FollowerNode {
   void onMeasurement(const RelativeMeasurement::ConstPtr& msg);
   void onLeaderBroadcast(const LeaderBroadcast::ConstPtr& msg);
   void onControlTick(const ros::TimerEvent& event);
+  /// The mode the inputs' ages give at @p now; fills @p ages.
+  FollowerMode modeAt(const ros::Time& now, FollowerInputAges* ages) const;
+  /// One control step stamped @p stamp (mutex_ held), @p delay s after it was due: mode, laws,
+  /// command, broadcast, status, markers, diagnostics. The one code path of both triggers.
+  void controlStep(const ros::Time& stamp, double delay);
   void onReconfigure(FollowerConfig& config, uint32_t level);
   void publishStatus(const ros::Time& now, const Eigen::VectorXd& xi, double measurement_age);
   void publishMarkers(const ros::Time& now, const Eigen::VectorXd& xi);
@@ -91,7 +123,13 @@ class FollowerNode {
   FollowerMode mode_ = FollowerMode::kWaiting;  ///< of the latest tick
   bool leader_fresh_ = false;                   ///< at the latest tick
   double last_xi_norm_ = 0.0;
-  long ticks_ = 0;
+  double period_ = 0.0;      ///< 1 / control_rate (s)
+  std::uint64_t ticks_ = 0;  ///< control steps run
+  std::uint32_t missed_periods_ = 0;
+  std::uint32_t late_periods_ = 0;
+  double tick_delay_ = 0.0;  ///< s, of the latest step
+  ros::Time last_expected_;  ///< the timer's previous expected time ("timer")
+  bool have_last_expected_ = false;
 
   ros::Subscriber measurement_subscriber_;
   ros::Subscriber leader_subscriber_;
