@@ -5,7 +5,8 @@
 #   2. callgrind: instructions per control step (load-independent);
 #   3. cf_sim against the SciPy LSODA reference, whole processes (scripts/solver_comparison.py);
 #   4. the ROS follower at 1 kHz on real time next to a bare roscpp relay
-#      (scripts/ros_latency.sh), unless --skip-ros;
+#      (scripts/ros_latency.sh, into doc/ros_latency.csv), unless --skip-ros (then the figures
+#      of its last run in doc/ros_latency.csv);
 #   5. platoon scale: scripts/formation_scale.sh with --with-scale (18 min), else the figures of
 #      its last run in doc/formation_scale.md.
 # Writes doc/performance.md and the table between the performance markers of README.md.
@@ -65,12 +66,10 @@ echo "== 3/5 cf_sim against SciPy LSODA ($reps repetitions)" >&2
 /usr/bin/python3 "$root/scripts/solver_comparison.py" --cf-sim "$bin/cf_sim" --reps "$reps" \
   --json "$work/solvers.json" >/dev/null
 
-ros_args=()
 if [ "$skip_ros" = 0 ]; then
   echo "== 4/5 ROS follower at 1 kHz ($ros_runs runs of $ros_duration s per setting)" >&2
   bash "$root/scripts/ros_latency.sh" --runs "$ros_runs" --duration "$ros_duration" \
-    --csv "$work/ros_latency.csv" >/dev/null
-  ros_args=(--ros-csv "$work/ros_latency.csv")
+    --csv "$root/doc/ros_latency.csv" >/dev/null
 fi
 
 if [ "$with_scale" = 1 ]; then
@@ -83,6 +82,7 @@ if [ "$update_readme" = 1 ]; then
   readme_args=(--readme "$root/README.md")
 fi
 /usr/bin/python3 "$root/scripts/performance_report.py" --benchmark "$work/benchmark.json" \
-  --instructions "$work/instructions.csv" --solvers "$work/solvers.json" "${ros_args[@]}" \
+  --instructions "$work/instructions.csv" --solvers "$work/solvers.json" \
+  --ros-csv "$root/doc/ros_latency.csv" \
   --scale "$root/doc/formation_scale.md" --reps "$reps" --out "$root/doc/performance.md" \
   "${readme_args[@]}"

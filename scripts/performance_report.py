@@ -139,7 +139,9 @@ def main(argv=None):
              "(1 kHz, 1 substep), embedded along the diagonal in 2-D and 3-D. *Inside*: a "
              "constant measurement inside the bound, the projection idle. *On the bound*: a "
              "measurement outside, the estimate held on the sphere, the projection acting at "
-             "every derivative evaluation. Flops are counted from the code "
+             "every derivative evaluation. Heap allocations: counted in the timed loop, divided by its "
+             "steps (the benchmark harness itself allocates about once per run; "
+             "`test_no_allocation` asserts exactly zero for the steps). Flops are counted from the code "
              "(test/benchmark/StepFlops.hpp: +, -, *, /, sqrt each one; dense products); "
              "cycles per flop use the nominal clock; instructions per step come from callgrind "
              "(difference of 11000 and 1000 steps, /10000).", "",
@@ -151,7 +153,7 @@ def main(argv=None):
             r = row[regime]
             target = STEP_TARGET_NS.get(row["axes"])
             target_text = f"≤ {target / 1000:g} µs, 0 allocations" if target else ""
-            lines.append(f"| {row['axes']} | {label} | {r['ns']:.0f} ns | {r['allocations']:g} | "
+            lines.append(f"| {row['axes']} | {label} | {r['ns']:.0f} ns | {r['allocations']:.6f} | "
                          f"{r['flops']:.0f} | {r['cycles_per_flop']:.2f} | "
                          f"{r['instructions']:.0f} | {r['instructions_per_flop']:.2f} | "
                          f"{target_text} |")
@@ -168,7 +170,7 @@ def main(argv=None):
               "`scripts/solver_comparison.py`: whole processes (start, YAML, simulation, summary "
               "line), every configuration once per repetition in turn, median over "
               f"{solvers['reps']} repetitions. Error: the largest of ‖ξ − ξ*‖ and ‖ξ̂ − ξ̂*‖ "
-              "over the 100 Hz grid against LSODA at rtol 1e-12, atol 1e-14 (DOP853 at the same "
+              "over the 10 Hz grid against LSODA at rtol 1e-12, atol 1e-14 (DOP853 at the same "
               f"tolerances differs from that by {solvers['truth_check']:.1e}). "
               "`cf_sim --continuous h` integrates the same continuous-time model as the "
               "reference (RK4 at the fixed step h); plain `cf_sim` runs the sampled controller "
@@ -221,14 +223,24 @@ def main(argv=None):
 
 
 def ros_rows(ros):
-    """Per-setting medians of the ROS runs: {setting: {column: median}}."""
+    """Per-setting medians of the runs that completed: {setting: {short name: median}}."""
+    names = {"relay_p50_us": "relay_p50_us", "relay_p99_us": "relay_p99_us",
+             "measurement_p50_us": "follower_measurement_p50_us",
+             "measurement_p99_us": "follower_measurement_p99_us",
+             "timer_p50_us": "follower_timer_p50_us", "timer_p99_us": "follower_timer_p99_us",
+             "added_p50_percent": "added_p50_percent", "added_p99_percent": "added_p99_percent",
+             "measurement_missed_percent": "follower_measurement_missed_percent",
+             "measurement_late_percent": "follower_measurement_late_percent",
+             "timer_missed_percent": "follower_timer_missed_percent",
+             "timer_late_percent": "follower_timer_late_percent",
+             "probe_skipped_percent": "probe_skipped_percent", "load": "load1_before"}
     settings = {}
     for r in ros:
-        settings.setdefault(r["keep_awake"], []).append(r)
+        if r.get("ok", "True") == "True":
+            settings.setdefault(r["setting"], []).append(r)
     result = {}
     for setting, rows in settings.items():
-        keys = [k for k in rows[0] if k not in ("keep_awake", "run")]
-        result[setting] = {k: median_of(rows, k) for k in keys}
+        result[setting] = {short: median_of(rows, column) for short, column in names.items()}
         result[setting]["runs"] = len(rows)
     return result
 
@@ -245,18 +257,20 @@ def ros_section(ros):
              "the command computed from it. Missed periods: scheduled periods that never ran; "
              "late: ran more than half a period after their due time. Medians over the runs; "
              "*as is*: the machine untouched; *kept awake*: one `nice -n 19` busy loop per core "
-             "(this VM wakes idle cores late).", "",
+             "(this VM wakes idle cores late). The probe's own 1 kHz thread skips periods too "
+             "(column probe): the machine, not the follower, sets the floor.", "",
              "| setting | runs | relay p50 / p99 (µs) | follower (measurement) p50 / p99 (µs) | "
              "added to the relay (p50) | follower (timer) p50 / p99 (µs) | missed / late "
-             "periods, measurement | missed / late periods, timer |",
-             "|---|---:|---|---|---:|---|---|---|"]
+             "periods, measurement | missed / late periods, timer | probe skipped | load |",
+             "|---|---:|---|---|---:|---|---|---|---:|---:|"]
     for setting, m in sorted(medians.items()):
         lines.append(
             f"| {setting} | {m['runs']} | {m['relay_p50_us']:.0f} / {m['relay_p99_us']:.0f} | "
             f"{m['measurement_p50_us']:.0f} / {m['measurement_p99_us']:.0f} | "
             f"{m['added_p50_percent']:+.0f} % | {m['timer_p50_us']:.0f} / {m['timer_p99_us']:.0f} | "
             f"{m['measurement_missed_percent']:.3f} % / {m['measurement_late_percent']:.3f} % | "
-            f"{m['timer_missed_percent']:.3f} % / {m['timer_late_percent']:.3f} % |")
+            f"{m['timer_missed_percent']:.3f} % / {m['timer_late_percent']:.3f} % | "
+            f"{m['probe_skipped_percent']:.3f} % | {m['load']:.2f} |")
     lines.append("")
     return lines
 
@@ -269,7 +283,7 @@ def readme_table(step_rows, run_sampled, solvers, ros, scale, reps, today):
         i, o = row["inside"], row["outside"]
         rows.append(
             f"| one control step, {row['axes']}-D (inside / on the bound) | {i['ns']:.0f} / "
-            f"{o['ns']:.0f} ns; {i['allocations']:g} / {o['allocations']:g} heap allocations; "
+            f"{o['ns']:.0f} ns; {i['allocations']:.6f} / {o['allocations']:.6f} heap allocations per step; "
             f"{i['flops']:.0f} / {o['flops']:.0f} flops = {i['cycles_per_flop']:.2f} / "
             f"{o['cycles_per_flop']:.2f} cycles per flop; {i['instructions']:.0f} / "
             f"{o['instructions']:.0f} instructions (callgrind) | {target}"

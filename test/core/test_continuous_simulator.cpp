@@ -3,6 +3,7 @@
 /// converging to it at first order in the period.
 
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -79,15 +80,19 @@ TEST(ContinuousSimulator, Run1LeavesTheBoundWhileTheEstimateStaysInside) {
   EXPECT_LT(s.max_boundary_correction, 1e-9);
 }
 
-// Halving the step divides the error by about 2^4 = 16 while it is above rounding.
-TEST(ContinuousSimulator, ConvergesAtFourthOrder) {
-  for (const char* name : {"paper_run1.yaml", "paper_run2.yaml"}) {
+// Halving the step divides the error by about 2^4 = 16 where the right-hand side is smooth
+// (Run 2: the projection barely acts). In Run 1 the estimate slides along the sphere and the
+// projection switches on and off, where the field is only Lipschitz: the order drops, but stays
+// above two.
+TEST(ContinuousSimulator, ConvergesAtFourthOrderWhereSmooth) {
+  for (const auto& [name, least_ratio] :
+       {std::make_pair("paper_run2.yaml", 10.0), std::make_pair("paper_run1.yaml", 4.0)}) {
     const Scenario scenario = loadScenarioFile(scenarioPath(name));
     const std::vector<SimulationSample> fine = continuousRun(scenario, 0.000625);
     const double coarse_error = largestDifference(continuousRun(scenario, 0.01), fine);
     const double half_error = largestDifference(continuousRun(scenario, 0.005), fine);
     EXPECT_GT(coarse_error, 1e-10) << name;  // far above the fine run's own error
-    EXPECT_GT(coarse_error / half_error, 10.0)
+    EXPECT_GT(coarse_error / half_error, least_ratio)
         << name << ": " << coarse_error << " then " << half_error;
   }
 }

@@ -124,7 +124,7 @@ TEST(NoAllocation, SampledSimulationPerTick) {
     const double long_peak = simulate(scenario).max_xi;
     const long long_run = testing::allocationCount() - before_long;
     EXPECT_EQ(long_run, short_run) << axes << " axes";
-    EXPECT_GT(long_peak, short_peak);  // the push at 20-23 s is in both; the peak follows it
+    EXPECT_GE(long_peak, short_peak);  // the same first 30 s, then more ticks
   }
 }
 
