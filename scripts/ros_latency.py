@@ -4,10 +4,12 @@
 `run` launches test/performance/latency.launch RUNS times per setting, each on its own master
 (roslaunch -p PORT), and keeps the probe's JSON of each run; the settings are the machine as it
 is ("as is") and with one nice-19 busy loop per core ("keep-awake": on this Firecracker VM an
-idle core halts and wakes late, which delays timers and message deliveries). Then it writes the
+idle core halts and wakes late, which delays timers and message deliveries), and with --realtime
+also every node under SCHED_FIFO with the cores kept awake ("keep-awake, SCHED_FIFO": probe,
+relay and both followers alike, through the launch's launch_prefix). Then it writes the
 raw per-run figures to CSV and prints a Markdown table of medians over the runs of each setting.
 
-Usage: ros_latency.py --runs N --duration S --rate HZ --keep-awake none|both|all
+Usage: ros_latency.py --runs N --duration S --rate HZ --keep-awake none|both|all [--realtime]
                       --csv doc/ros_latency.csv --port 11421 --work DIR
   --keep-awake none: as is only; all: keep-awake only; both: as is, then keep-awake.
 """
@@ -28,6 +30,9 @@ STREAMS = ("relay", "follower_measurement", "follower_timer")
 FOLLOWERS = ("follower_measurement", "follower_timer")
 TARGET_PERIODS_PERCENT = 0.1  # missed or late periods, at most
 TARGET_ADDED_PERCENT = 20.0  # latency the measurement-triggered follower adds to the relay's
+
+
+REALTIME_PRIORITY = 50  # SCHED_FIFO priority of every node in the realtime setting
 
 
 def log(*words):
@@ -65,9 +70,9 @@ def loadavg():
         return float(f.read().split()[0])
 
 
-def run_one(args, setting, index):
+def run_one(args, setting, index, realtime=False):
     """One launch; returns the CSV row (ok False when the probe wrote nothing usable)."""
-    tag = "%s_%d" % (setting.replace(" ", "_").replace("-", "_"), index)
+    tag = "%s_%d" % (setting.replace(", ", "_").replace(" ", "_").replace("-", "_"), index)
     output = os.path.join(args.work, tag + ".json")
     launch_log = os.path.join(args.work, tag + ".log")
     if os.path.exists(output):
@@ -76,6 +81,8 @@ def run_one(args, setting, index):
                ROS_LOG_DIR=os.path.join(args.work, "ros_logs"))
     command = ["roslaunch", "-p", str(args.port), LAUNCH, "duration:=%g" % args.duration,
                "rate:=%g" % args.rate, "control_rate:=%g" % args.rate, "output:=%s" % output]
+    if realtime:
+        command.append("launch_prefix:=chrt -f %d" % REALTIME_PRIORITY)
     row = {"setting": setting, "run": index, "duration_s": args.duration, "rate_hz": args.rate,
            "load1_before": loadavg(), "ok": False}
     total0, steal0 = cpu_times()
@@ -131,16 +138,19 @@ def run_one(args, setting, index):
 
 def run(args):
     os.makedirs(args.work, exist_ok=True)
-    settings = {"none": [False], "all": [True], "both": [False, True]}[args.keep_awake]
+    settings = [(False, False), (True, False)]
+    settings = {"none": settings[:1], "all": settings[1:], "both": settings}[args.keep_awake]
+    if args.realtime:
+        settings.append((True, True))
     rows = []
-    for awake in settings:
-        setting = "keep-awake" if awake else "as is"
+    for awake, realtime in settings:
+        setting = "keep-awake, SCHED_FIFO" if realtime else ("keep-awake" if awake else "as is")
         spinners = start_spinners() if awake else []
         try:
             for index in range(1, args.runs + 1):
                 log("%s, run %d of %d: %g s at %g Hz (load average %.2f)"
                     % (setting, index, args.runs, args.duration, args.rate, loadavg()))
-                row = run_one(args, setting, index)
+                row = run_one(args, setting, index, realtime)
                 rows.append(row)
                 if row["ok"]:
                     log("  relay p50 %.0f / p99 %.0f us; measurement-triggered p50 %.0f / p99 %.0f "
@@ -247,6 +257,9 @@ def main():
     parser.add_argument("--duration", type=float, default=60.0)
     parser.add_argument("--rate", type=float, default=1000.0)
     parser.add_argument("--keep-awake", choices=("none", "both", "all"), default="both")
+    parser.add_argument("--realtime", action="store_true",
+                        help="also run every node under SCHED_FIFO (chrt -f %d), cores kept awake"
+                        % REALTIME_PRIORITY)
     parser.add_argument("--csv", default=os.path.join(ROOT, "doc", "ros_latency.csv"))
     parser.add_argument("--port", type=int, default=11421)
     parser.add_argument("--work", required=True)

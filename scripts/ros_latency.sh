@@ -7,13 +7,15 @@
 # Prints a Markdown table of medians over the runs (relay p50/p99, measurement-triggered
 # follower p50/p99 and its added latency over the relay of the same run, timer follower p50/p99,
 # missed and late periods in %) and writes the raw per-run figures to CSV.
-# Usage: scripts/ros_latency.sh [--runs N] [--duration S] [--keep-awake none|both|all]
+# Usage: scripts/ros_latency.sh [--runs N] [--duration S] [--keep-awake none|both|all] [--realtime]
 #                               [--csv FILE] [--rate HZ] [--port PORT] [--work DIR]
 #   --runs      launches per setting (default 3)
 #   --duration  measured seconds per launch (default 60; plus ~10 s of start-up and warm-up)
 #   --keep-awake  none: the machine as it is; all: with one nice-19 busy loop per core, which
 #               keeps this VM's cores from halting when idle (a halted core wakes late, delaying
 #               timers and deliveries); both (default): as is, then kept awake
+#   --realtime  also a setting with every node (probe, relay, followers) under SCHED_FIFO
+#               priority 50 (chrt; needs root or CAP_SYS_NICE) and the cores kept awake
 #   --csv       raw per-run figures (default doc/ros_latency.csv)
 #   --rate      Hz of the measurements and of control_rate (default 1000)
 #   --port      ROS master port (default 11421)
@@ -30,6 +32,7 @@ csv=$root/doc/ros_latency.csv
 rate=1000
 port=11421
 work=
+realtime=()
 while (($#)); do
   case $1 in
     --runs) runs=$2; shift 2 ;;
@@ -39,6 +42,7 @@ while (($#)); do
     --rate) rate=$2; shift 2 ;;
     --port) port=$2; shift 2 ;;
     --work) work=$2; shift 2 ;;
+    --realtime) realtime=(--realtime); shift ;;
     -h|--help) sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0 ;;
     *) echo "ros_latency.sh: unknown argument $1 (see --help)" >&2; exit 2 ;;
   esac
@@ -57,4 +61,5 @@ set -u
 export ROS_MASTER_URI=http://localhost:$port
 echo "ros_latency: work directory (probe JSON, launch and ROS logs): $work" >&2
 /usr/bin/python3 "$root/scripts/ros_latency.py" --runs "$runs" --duration "$duration" \
-  --rate "$rate" --keep-awake "$keep_awake" --csv "$csv" --port "$port" --work "$work"
+  --rate "$rate" --keep-awake "$keep_awake" --csv "$csv" --port "$port" --work "$work" \
+  "${realtime[@]}"
