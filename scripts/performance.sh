@@ -9,9 +9,10 @@
 #      of its last run in doc/ros_latency.csv);
 #   5. platoon scale: scripts/formation_scale.sh with --with-scale (18 min), else the figures of
 #      its last run in doc/formation_scale.md.
-# Writes doc/performance.md and the table between the performance markers of README.md.
+# Writes the raw figures to doc/performance_data/, then doc/performance.md and the table between
+# the performance markers of README.md; --report-only renders those two from the raw figures.
 # Usage: scripts/performance.sh [--reps N] [--ros-runs N] [--ros-duration S] [--skip-ros]
-#                               [--with-scale] [--no-readme]
+#                               [--with-scale] [--no-readme] [--report-only]
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 build_dir=${BUILD_DIR:-$root/build}
@@ -21,6 +22,7 @@ ros_duration=60
 skip_ros=0
 with_scale=0
 update_readme=1
+report_only=0
 while [ $# -gt 0 ]; do
   case "$1" in
     --reps) reps=$2; shift 2 ;;
@@ -29,11 +31,15 @@ while [ $# -gt 0 ]; do
     --skip-ros) skip_ros=1; shift ;;
     --with-scale) with_scale=1; shift ;;
     --no-readme) update_readme=0; shift ;;
-    *) echo "usage: $0 [--reps N] [--ros-runs N] [--ros-duration S] [--skip-ros] [--with-scale] [--no-readme]" >&2
+    --report-only) report_only=1; shift ;;
+    *) echo "usage: $0 [--reps N] [--ros-runs N] [--ros-duration S] [--skip-ros] [--with-scale] [--no-readme] [--report-only]" >&2
        exit 2 ;;
   esac
 done
 
+data=$root/doc/performance_data
+mkdir -p "$data"
+if [ "$report_only" = 0 ]; then
 BUILD_DIR=$build_dir "$root/scripts/build.sh" >/dev/null
 bin=$build_dir/devel/lib/projection_collision_avoidance
 for tool in benchmark_follower_step step_instructions cf_sim; do
@@ -43,13 +49,14 @@ command -v valgrind >/dev/null || { echo "valgrind is needed for the instruction
 
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
+echo "$reps" >"$data/repetitions"
 
 echo "== 1/5 Google Benchmark ($reps repetitions)" >&2
 "$bin/benchmark_follower_step" --benchmark_repetitions="$reps" \
-  --benchmark_report_aggregates_only=true --benchmark_format=json >"$work/benchmark.json"
+  --benchmark_report_aggregates_only=true --benchmark_format=json >"$data/benchmark.json"
 
 echo "== 2/5 callgrind instructions per step" >&2
-: >"$work/instructions.csv"
+: >"$data/instructions.csv"
 for axes in 1 2 3; do
   for regime in inside outside; do
     counts=()
@@ -58,13 +65,13 @@ for axes in 1 2 3; do
         "$bin/step_instructions" "$axes" "$steps" "$regime" >/dev/null 2>"$work/callgrind.log"
       counts+=("$(sed -n 's/.*Collected : \([0-9]*\).*/\1/p' "$work/callgrind.log")")
     done
-    echo "$axes,$regime,${counts[0]},${counts[1]}" >>"$work/instructions.csv"
+    echo "$axes,$regime,${counts[0]},${counts[1]}" >>"$data/instructions.csv"
   done
 done
 
 echo "== 3/5 cf_sim against SciPy LSODA ($reps repetitions)" >&2
 /usr/bin/python3 "$root/scripts/solver_comparison.py" --cf-sim "$bin/cf_sim" --reps "$reps" \
-  --json "$work/solvers.json" >/dev/null
+  --json "$data/solvers.json" >/dev/null
 
 if [ "$skip_ros" = 0 ]; then
   echo "== 4/5 ROS follower at 1 kHz ($ros_runs runs of $ros_duration s per setting)" >&2
@@ -77,12 +84,14 @@ if [ "$with_scale" = 1 ]; then
   bash "$root/scripts/formation_scale.sh" >/dev/null
 fi
 
+fi
+
 readme_args=()
 if [ "$update_readme" = 1 ]; then
   readme_args=(--readme "$root/README.md")
 fi
-/usr/bin/python3 "$root/scripts/performance_report.py" --benchmark "$work/benchmark.json" \
-  --instructions "$work/instructions.csv" --solvers "$work/solvers.json" \
+/usr/bin/python3 "$root/scripts/performance_report.py" --benchmark "$data/benchmark.json" \
+  --instructions "$data/instructions.csv" --solvers "$data/solvers.json" \
   --ros-csv "$root/doc/ros_latency.csv" \
-  --scale "$root/doc/formation_scale.md" --reps "$reps" --out "$root/doc/performance.md" \
+  --scale "$root/doc/formation_scale.md" --reps "$(cat "$data/repetitions")" --out "$root/doc/performance.md" \
   "${readme_args[@]}"

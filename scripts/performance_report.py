@@ -233,7 +233,8 @@ def ros_rows(ros):
              "measurement_late_percent": "follower_measurement_late_percent",
              "timer_missed_percent": "follower_timer_missed_percent",
              "timer_late_percent": "follower_timer_late_percent",
-             "probe_skipped_percent": "probe_skipped_percent", "load": "load1_before"}
+             "probe_skipped_percent": "probe_skipped_percent", "load": "load1_before",
+             "steal_percent": "steal_percent"}
     settings = {}
     for r in ros:
         if r.get("ok", "True") == "True":
@@ -252,7 +253,8 @@ def ros_section(ros):
              "publishes relative measurements at 1 kHz on real time; a bare roscpp relay "
              "(`test/performance/measurement_relay.cpp`), a follower triggered by each "
              "measurement (`~trigger: measurement`) and a follower on its 1 kHz timer "
-             "(`~trigger: timer`) all subscribe to it in the same run. Latency: from the "
+             "(`~trigger: timer`) all subscribe to it in the same run; in the SCHED_FIFO setting all "
+             "four run under `chrt -f 50`. Latency: from the "
              "measurement's publication to the probe's receipt of the relayed measurement or of "
              "the command computed from it. Missed periods: scheduled periods that never ran; "
              "late: ran more than half a period after their due time. Medians over the runs; "
@@ -261,8 +263,8 @@ def ros_section(ros):
              "(column probe): the machine, not the follower, sets the floor.", "",
              "| setting | runs | relay p50 / p99 (µs) | follower (measurement) p50 / p99 (µs) | "
              "added to the relay (p50) | follower (timer) p50 / p99 (µs) | missed / late "
-             "periods, measurement | missed / late periods, timer | probe skipped | load |",
-             "|---|---:|---|---|---:|---|---|---|---:|---:|"]
+             "periods, measurement | missed / late periods, timer | probe skipped | load | steal |",
+             "|---|---:|---|---|---:|---|---|---|---:|---:|---:|"]
     for setting, m in sorted(medians.items()):
         lines.append(
             f"| {setting} | {m['runs']} | {m['relay_p50_us']:.0f} / {m['relay_p99_us']:.0f} | "
@@ -270,7 +272,26 @@ def ros_section(ros):
             f"{m['added_p50_percent']:+.0f} % | {m['timer_p50_us']:.0f} / {m['timer_p99_us']:.0f} | "
             f"{m['measurement_missed_percent']:.3f} % / {m['measurement_late_percent']:.3f} % | "
             f"{m['timer_missed_percent']:.3f} % / {m['timer_late_percent']:.3f} % | "
-            f"{m['probe_skipped_percent']:.3f} % | {m['load']:.2f} |")
+            f"{m['probe_skipped_percent']:.3f} % | {m['load']:.2f} | {m['steal_percent']:.1f} % |")
+    lines += ["", "Every run (steal: the share of CPU time the hypervisor gave to other guests during "
+              "the run, from /proc/stat; a run with much steal measures the host):", "",
+              "| setting | run | steal | relay p50 / p99 (µs) | follower (measurement) p50 / p99 "
+              "(µs) | added (p50) | missed / late, measurement | missed / late, timer | "
+              "probe skipped |", "|---|---:|---:|---|---|---:|---|---|---:|"]
+    for r in ros:
+        if r.get("ok", "True") != "True":
+            lines.append(f"| {r['setting']} | {r['run']} | | failed | | | | | |")
+            continue
+        f = {k: float(v) for k, v in r.items() if k not in ("setting", "send_order", "ok")
+             and v not in ("", "nan") and re.match(r"^-?[0-9.e+-]+$", v)}
+        lines.append(
+            f"| {r['setting']} | {r['run']} | {f['steal_percent']:.1f} % | "
+            f"{f['relay_p50_us']:.0f} / {f['relay_p99_us']:.0f} | "
+            f"{f['follower_measurement_p50_us']:.0f} / {f['follower_measurement_p99_us']:.0f} | "
+            f"{f['added_p50_percent']:+.0f} % | {f['follower_measurement_missed_percent']:.3f} / "
+            f"{f['follower_measurement_late_percent']:.3f} % | "
+            f"{f['follower_timer_missed_percent']:.3f} / {f['follower_timer_late_percent']:.3f} % | "
+            f"{f['probe_skipped_percent']:.3f} % |")
     lines.append("")
     return lines
 
@@ -303,7 +324,8 @@ def readme_table(step_rows, run_sampled, solvers, ros, scale, reps, today):
     if ros:
         for setting, m in sorted(ros_rows(ros).items()):
             rows.append(
-                f"| ROS follower at 1 kHz, 60 s ({setting}): missed / late periods | timer: "
+                f"| ROS follower at 1 kHz, 60 s ({setting}; median steal "
+                f"{m['steal_percent']:.1f} %): missed / late periods | timer: "
                 f"{m['timer_missed_percent']:.3f} / {m['timer_late_percent']:.3f} %; "
                 f"measurement-triggered: {m['measurement_missed_percent']:.3f} / "
                 f"{m['measurement_late_percent']:.3f} % | ≤ 0.1 % |")
