@@ -42,6 +42,9 @@ import sys
 import tempfile
 import time
 
+from process_control import start_spinners
+from process_control import stop as stop_process
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SCENARIO = os.path.join(ROOT, "config", "scenarios", "paper_run2.yaml")
 CLK_TCK = os.sysconf("SC_CLK_TCK")
@@ -144,29 +147,15 @@ def classify(pid):
 
 
 def stop(proc, name, timeout=40.0):
-    """SIGINT, then SIGTERM, then SIGKILL to one process that this script started."""
-    for sig, wait in ((signal.SIGINT, timeout), (signal.SIGTERM, 10.0), (signal.SIGKILL, 5.0)):
-        if proc.poll() is not None:
-            return
-        proc.send_signal(sig)
-        try:
-            proc.wait(wait)
-            return
-        except subprocess.TimeoutExpired:
-            log("%s did not end after %s" % (name, signal.Signals(sig).name))
+    """process_control.stop(), logging each signal @p name outlives."""
+    stop_process(proc, timeout,
+                 lambda signal_name: log("%s did not end after %s" % (name, signal_name)))
 
 
 def cpu_share(cpu0, cpu1, watched, role, window):
     """Percent of one core used by the processes of ROLE over the window."""
     return sum((cpu1[p] - cpu0[p]) / window * 100.0 for p, r in watched.items()
                if r == role and cpu0[p] is not None and cpu1[p] is not None)
-
-
-def start_spinners():
-    """One lowest-priority busy loop per core: keeps the VM's cores from idling (halting), so
-    that a timer's wake-up does not wait for the hypervisor to resume a halted core."""
-    return [subprocess.Popen(["nice", "-n", "19", "sh", "-c", "while :; do :; done"])
-            for _ in range(os.cpu_count())]
 
 
 def read_bag(path, n, t0, t1, period):

@@ -18,11 +18,12 @@ import argparse
 import csv
 import json
 import os
-import signal
 import statistics
 import subprocess
 import sys
 import time
+
+from process_control import start_spinners, stop
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 LAUNCH = os.path.join(ROOT, "test", "performance", "latency.launch")
@@ -37,25 +38,6 @@ REALTIME_PRIORITY = 50  # SCHED_FIFO priority of every node in the realtime sett
 
 def log(*words):
     print("[ros_latency]", *words, file=sys.stderr, flush=True)
-
-
-def start_spinners():
-    """One lowest-priority busy loop per core: keeps the VM's cores from halting when idle."""
-    return [subprocess.Popen(["nice", "-n", "19", "sh", "-c", "while :; do :; done"])
-            for _ in range(os.cpu_count())]
-
-
-def stop(proc, timeout=20.0):
-    """SIGINT, then SIGTERM, then SIGKILL to one process this script started."""
-    for sig, wait in ((signal.SIGINT, timeout), (signal.SIGTERM, 10.0), (signal.SIGKILL, 5.0)):
-        if proc.poll() is not None:
-            return
-        proc.send_signal(sig)
-        try:
-            proc.wait(wait)
-            return
-        except subprocess.TimeoutExpired:
-            pass
 
 
 def cpu_times():

@@ -47,13 +47,9 @@ class CollisionFreeEstimator {
   /// @param design validated parameters; their sizes must match Dims (std::invalid_argument)
   explicit CollisionFreeEstimator(const ControllerDesign& design)
       : constraint_(design.xi_max, design.parameters.epsilon) {
-    const Eigen::Index n = design.parameters.model.stateDimension();
-    const Eigen::Index m = design.parameters.model.inputDimension();
-    const Eigen::Index p = design.parameters.model.outputDimension();
-    if ((Dims::kStates != Eigen::Dynamic && Dims::kStates != n) ||
-        (Dims::kInputs != Eigen::Dynamic && Dims::kInputs != m) ||
-        (Dims::kOutputs != Eigen::Dynamic && Dims::kOutputs != p) || n > Dims::kMaxStates ||
-        m > Dims::kMaxInputs || p > Dims::kMaxOutputs) {
+    if (!Dims::fits(design.parameters.model.stateDimension(),
+                    design.parameters.model.inputDimension(),
+                    design.parameters.model.outputDimension())) {
       throw std::invalid_argument("CollisionFreeEstimator: model sizes do not fit the dimensions");
     }
     estimator_matrix_ = design.estimator_matrix;
@@ -61,7 +57,7 @@ class CollisionFreeEstimator {
     input_matrix_ = design.parameters.model.B;
     observer_gain_ = design.parameters.estimator_gain;
     gamma_inverse_ = design.gamma_inverse;
-    estimate_ = StateVector::Zero(n);
+    estimate_ = StateVector::Zero(design.parameters.model.stateDimension());
   }
 
   /// Sets the estimate, scaled into Omega_1 if it lies outside; zero if it is not finite.

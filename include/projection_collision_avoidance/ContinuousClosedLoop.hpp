@@ -55,13 +55,7 @@ class ContinuousClosedLoop {
         in_command_(design.parameters.leader_input_in_command),
         in_estimator_(design.parameters.leader_input_in_estimator) {
     const AgentModel& model = design.parameters.model;
-    const Eigen::Index n = model.stateDimension();
-    const Eigen::Index m = model.inputDimension();
-    const Eigen::Index p = model.outputDimension();
-    if ((Dims::kStates != Eigen::Dynamic && Dims::kStates != n) ||
-        (Dims::kInputs != Eigen::Dynamic && Dims::kInputs != m) ||
-        (Dims::kOutputs != Eigen::Dynamic && Dims::kOutputs != p) || n > Dims::kMaxStates ||
-        m > Dims::kMaxInputs || p > Dims::kMaxOutputs) {
+    if (!Dims::fits(model.stateDimension(), model.inputDimension(), model.outputDimension())) {
       throw std::invalid_argument("ContinuousClosedLoop: model sizes do not fit the dimensions");
     }
     state_matrix_ = model.A;

@@ -43,6 +43,14 @@ struct Dimensions {
   using FeedbackGainMatrix = BoundedMatrix<M, P, kMaxInputs, kMaxOutputs>;  ///< m x p: G, G_e
   using ObserverGainMatrix = BoundedMatrix<N, P, kMaxStates, kMaxOutputs>;  ///< n x p: L, pinv(C)
   using StateGainMatrix = BoundedMatrix<M, N, kMaxInputs, kMaxStates>;      ///< m x n: K_f
+
+  /// Whether a model of n states, m inputs and p outputs fits: each size equal to the fixed one,
+  /// or within the bound where the size is dynamic.
+  static constexpr bool fits(Eigen::Index n, Eigen::Index m, Eigen::Index p) {
+    return (N == Eigen::Dynamic || N == n) && (M == Eigen::Dynamic || M == m) &&
+           (P == Eigen::Dynamic || P == p) && n <= kMaxStates && m <= kMaxInputs &&
+           p <= kMaxOutputs;
+  }
 };
 
 /// Double integrator on one axis: x = [p; v], u = acceleration, y = x.
