@@ -22,8 +22,10 @@ set(PCA_CORE_SOURCES
   src/core/SimulationCsvWriter.cpp
 )
 
-# projection_collision_avoidance_scenario: scenario files (yaml-cpp) and the cf_sim command.
+# projection_collision_avoidance_scenario: scenario files (libyaml parses them into yaml-cpp
+# trees) and the cf_sim command.
 set(PCA_SCENARIO_SOURCES
   src/scenario/CfSimApp.cpp
   src/scenario/ScenarioLoader.cpp
+  src/scenario/YamlParser.cpp
 )

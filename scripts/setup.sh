@@ -8,7 +8,7 @@ set -euo pipefail
 packages=(
   build-essential cmake pkg-config git
   catkin python3-catkin-pkg catkin-lint
-  libeigen3-dev libyaml-cpp-dev
+  libeigen3-dev libyaml-cpp-dev libyaml-dev
   googletest libgtest-dev libbenchmark-dev
   clang libclang-rt-14-dev llvm  # scripts/sanitize.sh: ASan, UBSan, libFuzzer, llvm-symbolizer
   python3-yaml python3-numpy python3-scipy python3-matplotlib

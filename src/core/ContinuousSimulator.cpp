@@ -24,6 +24,9 @@ Vector toBounded(const Eigen::VectorXd& v) {
   return result;
 }
 
+/// No segment: the pulses must be taken afresh.
+constexpr std::size_t kNoSegment = std::numeric_limits<std::size_t>::max();
+
 template <typename Dims>
 class ContinuousRun {
  public:
@@ -57,27 +60,59 @@ class ContinuousRun {
     return ud;
   }
 
-  /// One RK4 step of z from a to b, the pulses taken at the middle of [a, b].
+  /// The inputs of one RK4 step over [a, b] with no pulse edge inside: u_1 at a, at the middle
+  /// and at b, u_d at the middle, the pulses being those of the segment between two edges.
+  struct StepInputs {
+    InputVector leader_start;
+    InputVector leader_middle;
+    InputVector leader_end;
+    StateVector disturbance;
+  };
+
+  /// The pulse parts of u_1 and u_d, taken at @p pulse_time.
+  void setPulses(double pulse_time) {
+    leader_pulses_ = InputVector::Zero(inputs_);
+    scenario_.leader_input.addPulsesTo(pulse_time, leader_pulses_);
+    disturbance_pulses_ = StateVector::Zero(states_);
+    scenario_.disturbance.addPulsesTo(pulse_time, disturbance_pulses_);
+  }
+
+  /// The step's inputs from the pulses of setPulses() and the sinusoids at a, the middle, b.
+  StepInputs stepInputs(double a, double b) const {
+    const double middle = 0.5 * (a + b);
+    StepInputs inputs;
+    inputs.disturbance = disturbance_pulses_;
+    scenario_.disturbance.addSinusoidsTo(middle, inputs.disturbance);
+    inputs.leader_start = leader_pulses_;
+    if (scenario_.leader_input.hasSinusoids()) {
+      scenario_.leader_input.addSinusoidsTo(a, inputs.leader_start);
+      inputs.leader_middle = leader_pulses_;
+      scenario_.leader_input.addSinusoidsTo(middle, inputs.leader_middle);
+      inputs.leader_end = leader_pulses_;
+      scenario_.leader_input.addSinusoidsTo(b, inputs.leader_end);
+    } else {
+      inputs.leader_middle = inputs.leader_start;
+      inputs.leader_end = inputs.leader_start;
+    }
+    return inputs;
+  }
+
+  /// One RK4 step of z from a to b with the pulses of setPulses().
   void rk4(double a, double b, State* z) const {
     const double h = b - a;
-    const double middle = 0.5 * (a + b);
-    const StateVector ud = disturbance(middle, middle);
-    const bool varying = scenario_.leader_input.hasSinusoids();
-    const InputVector u1_start = leaderInput(a, middle);
-    const InputVector u1_middle = varying ? leaderInput(middle, middle) : u1_start;
-    const InputVector u1_end = varying ? leaderInput(b, middle) : u1_start;
+    const StepInputs in = stepInputs(a, b);
     State k1;
     State k2;
     State k3;
     State k4;
     State stage;
-    loop_.evaluate(*z, u1_start, ud, &k1);
+    loop_.evaluate(*z, in.leader_start, in.disturbance, &k1);
     axpy(*z, 0.5 * h, k1, &stage);
-    loop_.evaluate(stage, u1_middle, ud, &k2);
+    loop_.evaluate(stage, in.leader_middle, in.disturbance, &k2);
     axpy(*z, 0.5 * h, k2, &stage);
-    loop_.evaluate(stage, u1_middle, ud, &k3);
+    loop_.evaluate(stage, in.leader_middle, in.disturbance, &k3);
     axpy(*z, h, k3, &stage);
-    loop_.evaluate(stage, u1_end, ud, &k4);
+    loop_.evaluate(stage, in.leader_end, in.disturbance, &k4);
     const double sixth = h / 6.0;
     z->leader += sixth * (k1.leader + 2.0 * k2.leader + 2.0 * k3.leader + k4.leader);
     z->follower += sixth * (k1.follower + 2.0 * k2.follower + 2.0 * k3.follower + k4.follower);
@@ -108,6 +143,15 @@ class ContinuousRun {
     summary.min_separation = std::numeric_limits<double>::infinity();
     const long last_tick = std::lround(scenario_.duration / step);
     const double tolerance = 1e-9 * step;
+    // Every pulse edge of u_1 and u_d, once; between two edges the pulses are constant.
+    std::vector<double> edges = scenario_.leader_input.edgesWithin(
+        -std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity());
+    const std::vector<double> more = scenario_.disturbance.edgesWithin(
+        -std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity());
+    edges.insert(edges.end(), more.begin(), more.end());
+    std::sort(edges.begin(), edges.end());
+    std::size_t next_edge = 0;                // the first edge later than the step's start
+    std::size_t pulses_segment = kNoSegment;  // the segment whose pulses setPulses() holds
     for (long tick = 0; tick <= last_tick; ++tick) {
       const double t = static_cast<double>(tick) * step;
       record(t, z, step, observer, &summary);
@@ -115,23 +159,26 @@ class ContinuousRun {
         break;
       }
       const double t_end = static_cast<double>(tick + 1) * step;
-      if (!scenario_.leader_input.hasEdgeWithin(t + tolerance, t_end - tolerance) &&
-          !scenario_.disturbance.hasEdgeWithin(t + tolerance, t_end - tolerance)) {
+      while (next_edge < edges.size() && edges[next_edge] <= t + tolerance) {
+        ++next_edge;
+      }
+      if (next_edge == edges.size() || edges[next_edge] >= t_end - tolerance) {
+        if (pulses_segment != next_edge) {
+          setPulses(0.5 * (t + t_end));
+          pulses_segment = next_edge;
+        }
         rk4(t, t_end, &z);
-      } else {
-        std::vector<double> edges =
-            scenario_.leader_input.edgesWithin(t + tolerance, t_end - tolerance);
-        const std::vector<double> more =
-            scenario_.disturbance.edgesWithin(t + tolerance, t_end - tolerance);
-        edges.insert(edges.end(), more.begin(), more.end());
-        std::sort(edges.begin(), edges.end());
+      } else {  // split at the edges inside (t, t_end), the pulses taken in each piece
         double a = t;
-        for (const double edge : edges) {
-          if (edge > a) {
-            rk4(a, edge, &z);
-            a = edge;
+        for (; next_edge < edges.size() && edges[next_edge] < t_end - tolerance; ++next_edge) {
+          if (edges[next_edge] > a) {
+            setPulses(0.5 * (a + edges[next_edge]));
+            rk4(a, edges[next_edge], &z);
+            a = edges[next_edge];
           }
         }
+        setPulses(0.5 * (a + t_end));
+        pulses_segment = kNoSegment;
         rk4(a, t_end, &z);
       }
       const double norm = clampNorm(z.estimate, radius_);
@@ -193,6 +240,8 @@ class ContinuousRun {
   const Scenario& scenario_;
   const ControllerDesign& design_;
   ContinuousClosedLoop<Dims> loop_;
+  InputVector leader_pulses_;       // pulse part of u_1 over the current segment
+  StateVector disturbance_pulses_;  // pulse part of u_d over the current segment
   Eigen::Index inputs_;
   Eigen::Index states_;
   int positions_;

@@ -16,6 +16,7 @@
 #include "projection_collision_avoidance/ControllerDesign.hpp"
 #include "projection_collision_avoidance/ParameterError.hpp"
 
+#include "YamlParser.hpp"
 #include "YamlReader.hpp"
 
 namespace projection_collision_avoidance {
@@ -79,9 +80,9 @@ void applyOverride(YAML::Node& root, const std::string& assignment) {
   }
   YAML::Node value;
   try {
-    value = YAML::Load(assignment.substr(equals + 1));
-  } catch (const YAML::Exception& error) {
-    throw ParameterError(key, std::string("the value is not YAML: ") + error.what());
+    value = detail::parseYaml(assignment.substr(equals + 1));
+  } catch (const ParameterError& error) {
+    throw ParameterError(key, "in the value: " + error.reason());
   }
   setAtPath(root, path, 0, value, key);
 }
@@ -351,13 +352,7 @@ Scenario scenarioFromYaml(const YAML::Node& root, const std::vector<std::string>
 }
 
 Scenario parseScenario(const std::string& yaml_text, const std::vector<std::string>& overrides) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(yaml_text);
-  } catch (const YAML::Exception& error) {
-    throw ParameterError("(file)", std::string("not valid YAML: ") + error.what());
-  }
-  return parseRoot(root, overrides);
+  return parseRoot(detail::parseYaml(yaml_text), overrides);
 }
 
 Scenario loadScenarioFile(const std::string& path, const std::vector<std::string>& overrides) {
