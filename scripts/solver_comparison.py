@@ -12,6 +12,8 @@ The error of a run is the largest of ||xi(t) - xi*(t)|| and ||xi_hat(t) - xi_hat
 
 Configurations:
   cf_sim --continuous h   the same continuous-time model, classical RK4 at the fixed step h
+  cf_sim --continuous h --method rk6
+                          the same, Butcher's 7-stage 6th-order method at the fixed step h
   cf_sim (sampled)        the deployed sampled-data controller at the scenario's control rate;
                           its distance to the continuous model is the zero-order hold, not a
                           solver error (first order in the period)
@@ -38,16 +40,21 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 REFERENCE = os.path.join(ROOT, "scripts", "reference_sim.py")
 PYTHON = "/usr/bin/python3"
 TRUTH_TOLERANCES = ("1e-12", "1e-14")
-CONTINUOUS_STEPS = ("0.1", "0.05", "0.02", "0.01", "0.005", "0.002")
+# Steps that land on the 10 Hz grid: 0.1 s / k.
+RK4_STEPS = tuple(f"{0.1 / k:.10g}" for k in (1, 2, 4, 5, 8, 10, 16, 20, 25, 32, 40, 50))
+RK6_STEPS = tuple(f"{0.1 / k:.10g}" for k in (1, 2, 4, 5, 8, 10))
 LSODA_TOLERANCES = (("1e-3", "1e-6"), ("1e-6", "1e-9"), ("1e-8", "1e-11"), ("1e-10", "1e-13"))
 
 
 def configurations(cf_sim, scenario):
     """(label, kind, argv) of every timed configuration."""
     result = []
-    for step in CONTINUOUS_STEPS:
+    for step in RK4_STEPS:
         result.append((f"cf_sim --continuous {step}", "cf_sim continuous",
                        [cf_sim, scenario, "--continuous", step]))
+    for step in RK6_STEPS:
+        result.append((f"cf_sim --continuous {step} --method rk6", "cf_sim continuous",
+                       [cf_sim, scenario, "--continuous", step, "--method", "rk6"]))
     result.append(("cf_sim (sampled)", "cf_sim sampled", [cf_sim, scenario]))
     for rtol, atol in LSODA_TOLERANCES:
         result.append((f"LSODA rtol {rtol} atol {atol}", "LSODA",

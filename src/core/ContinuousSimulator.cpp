@@ -1,6 +1,7 @@
 #include "projection_collision_avoidance/ContinuousSimulator.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -27,7 +28,39 @@ Vector toBounded(const Eigen::VectorXd& v) {
 /// No segment: the pulses must be taken afresh.
 constexpr std::size_t kNoSegment = std::numeric_limits<std::size_t>::max();
 
-template <typename Dims>
+/// Classical Runge-Kutta, 4 stages, order 4.
+struct ClassicalRungeKutta4 {
+  static constexpr int kStages = 4;
+  static constexpr std::array<double, kStages> c = {0.0, 0.5, 0.5, 1.0};
+  static constexpr std::array<std::array<double, kStages>, kStages> a = {{
+      {0.0, 0.0, 0.0, 0.0},
+      {0.5, 0.0, 0.0, 0.0},
+      {0.0, 0.5, 0.0, 0.0},
+      {0.0, 0.0, 1.0, 0.0},
+  }};
+  static constexpr std::array<double, kStages> b = {1.0 / 6.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 6.0};
+};
+
+/// Butcher's explicit method of order 6 with 7 stages (J. C. Butcher, "On Runge-Kutta processes
+/// of high order", J. Austral. Math. Soc. 4 (1964)).
+struct ButcherRungeKutta6 {
+  static constexpr int kStages = 7;
+  static constexpr std::array<double, kStages> c = {0.0,       1.0 / 3.0, 2.0 / 3.0, 1.0 / 3.0,
+                                                    1.0 / 2.0, 1.0 / 2.0, 1.0};
+  static constexpr std::array<std::array<double, kStages>, kStages> a = {{
+      {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0},
+      {1.0 / 3.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0},
+      {0.0, 2.0 / 3.0, 0.0, 0.0, 0.0, 0.0, 0.0},
+      {1.0 / 12.0, 1.0 / 3.0, -1.0 / 12.0, 0.0, 0.0, 0.0, 0.0},
+      {-1.0 / 16.0, 9.0 / 8.0, -3.0 / 16.0, -3.0 / 8.0, 0.0, 0.0, 0.0},
+      {0.0, 9.0 / 8.0, -3.0 / 8.0, -3.0 / 4.0, 1.0 / 2.0, 0.0, 0.0},
+      {9.0 / 44.0, -9.0 / 11.0, 63.0 / 44.0, 18.0 / 11.0, 0.0, -16.0 / 11.0, 0.0},
+  }};
+  static constexpr std::array<double, kStages> b = {
+      11.0 / 120.0, 0.0, 27.0 / 40.0, 27.0 / 40.0, -4.0 / 15.0, -4.0 / 15.0, 11.0 / 120.0};
+};
+
+template <typename Dims, typename Method>
 class ContinuousRun {
  public:
   using StateVector = typename Dims::StateVector;
@@ -60,15 +93,6 @@ class ContinuousRun {
     return ud;
   }
 
-  /// The inputs of one RK4 step over [a, b] with no pulse edge inside: u_1 at a, at the middle
-  /// and at b, u_d at the middle, the pulses being those of the segment between two edges.
-  struct StepInputs {
-    InputVector leader_start;
-    InputVector leader_middle;
-    InputVector leader_end;
-    StateVector disturbance;
-  };
-
   /// The pulse parts of u_1 and u_d, taken at @p pulse_time.
   void setPulses(double pulse_time) {
     leader_pulses_ = InputVector::Zero(inputs_);
@@ -77,46 +101,52 @@ class ContinuousRun {
     scenario_.disturbance.addPulsesTo(pulse_time, disturbance_pulses_);
   }
 
-  /// The step's inputs from the pulses of setPulses() and the sinusoids at a, the middle, b.
-  StepInputs stepInputs(double a, double b) const {
-    const double middle = 0.5 * (a + b);
-    StepInputs inputs;
-    inputs.disturbance = disturbance_pulses_;
-    scenario_.disturbance.addSinusoidsTo(middle, inputs.disturbance);
-    inputs.leader_start = leader_pulses_;
-    if (scenario_.leader_input.hasSinusoids()) {
-      scenario_.leader_input.addSinusoidsTo(a, inputs.leader_start);
-      inputs.leader_middle = leader_pulses_;
-      scenario_.leader_input.addSinusoidsTo(middle, inputs.leader_middle);
-      inputs.leader_end = leader_pulses_;
-      scenario_.leader_input.addSinusoidsTo(b, inputs.leader_end);
-    } else {
-      inputs.leader_middle = inputs.leader_start;
-      inputs.leader_end = inputs.leader_start;
-    }
-    return inputs;
-  }
-
-  /// One RK4 step of z from a to b with the pulses of setPulses().
-  void rk4(double a, double b, State* z) const {
+  /// One step of the method of z from a to b with the pulses of setPulses() and the sinusoids of
+  /// u_1 and u_d at the stage times a + c_i (b - a).
+  void advance(double a, double b, State* z) const {
     const double h = b - a;
-    const StepInputs in = stepInputs(a, b);
-    State k1;
-    State k2;
-    State k3;
-    State k4;
+    const bool leader_varies = scenario_.leader_input.hasSinusoids();
+    const bool disturbance_varies = scenario_.disturbance.hasSinusoids();
+    InputVector u1 = leader_pulses_;
+    StateVector ud = disturbance_pulses_;
+    std::array<State, Method::kStages> k;
     State stage;
-    loop_.evaluate(*z, in.leader_start, in.disturbance, &k1);
-    axpy(*z, 0.5 * h, k1, &stage);
-    loop_.evaluate(stage, in.leader_middle, in.disturbance, &k2);
-    axpy(*z, 0.5 * h, k2, &stage);
-    loop_.evaluate(stage, in.leader_middle, in.disturbance, &k3);
-    axpy(*z, h, k3, &stage);
-    loop_.evaluate(stage, in.leader_end, in.disturbance, &k4);
-    const double sixth = h / 6.0;
-    z->leader += sixth * (k1.leader + 2.0 * k2.leader + 2.0 * k3.leader + k4.leader);
-    z->follower += sixth * (k1.follower + 2.0 * k2.follower + 2.0 * k3.follower + k4.follower);
-    z->estimate += sixth * (k1.estimate + 2.0 * k2.estimate + 2.0 * k3.estimate + k4.estimate);
+    for (int i = 0; i < Method::kStages; ++i) {
+      stage = *z;
+      for (int j = 0; j < i; ++j) {
+        const double weight = h * Method::a[i][j];
+        if (weight != 0.0) {
+          stage.leader += weight * k[j].leader;
+          stage.follower += weight * k[j].follower;
+          stage.estimate += weight * k[j].estimate;
+        }
+      }
+      const double t = a + Method::c[i] * h;
+      if (leader_varies) {
+        u1 = leader_pulses_;
+        scenario_.leader_input.addSinusoidsTo(t, u1);
+      }
+      if (disturbance_varies) {
+        ud = disturbance_pulses_;
+        scenario_.disturbance.addSinusoidsTo(t, ud);
+      }
+      loop_.evaluate(stage, u1, ud, &k[i]);
+    }
+    // z += h sum_i b_i k_i, the sum formed first so that z is rounded once per step.
+    State increment;
+    increment.leader = Method::b[0] * k[0].leader;
+    increment.follower = Method::b[0] * k[0].follower;
+    increment.estimate = Method::b[0] * k[0].estimate;
+    for (int i = 1; i < Method::kStages; ++i) {
+      if (Method::b[i] != 0.0) {
+        increment.leader += Method::b[i] * k[i].leader;
+        increment.follower += Method::b[i] * k[i].follower;
+        increment.estimate += Method::b[i] * k[i].estimate;
+      }
+    }
+    z->leader += h * increment.leader;
+    z->follower += h * increment.follower;
+    z->estimate += h * increment.estimate;
   }
 
   SimulationSummary run(double step, const SampleObserver& observer) {
@@ -167,19 +197,19 @@ class ContinuousRun {
           setPulses(0.5 * (t + t_end));
           pulses_segment = next_edge;
         }
-        rk4(t, t_end, &z);
+        advance(t, t_end, &z);
       } else {  // split at the edges inside (t, t_end), the pulses taken in each piece
         double a = t;
         for (; next_edge < edges.size() && edges[next_edge] < t_end - tolerance; ++next_edge) {
           if (edges[next_edge] > a) {
             setPulses(0.5 * (a + edges[next_edge]));
-            rk4(a, edges[next_edge], &z);
+            advance(a, edges[next_edge], &z);
             a = edges[next_edge];
           }
         }
         setPulses(0.5 * (a + t_end));
         pulses_segment = kNoSegment;
-        rk4(a, t_end, &z);
+        advance(a, t_end, &z);
       }
       const double norm = clampNorm(z.estimate, radius_);
       if (norm > 0.0) {
@@ -190,12 +220,6 @@ class ContinuousRun {
   }
 
  private:
-  static void axpy(const State& z, double a, const State& k, State* result) {
-    result->leader = z.leader + a * k.leader;
-    result->follower = z.follower + a * k.follower;
-    result->estimate = z.estimate + a * k.estimate;
-  }
-
   void record(double t, const State& z, double step, const SampleObserver& observer,
               SimulationSummary* summary) const {
     const StateVector xi = z.leader - z.follower - design_.parameters.separation;
@@ -251,7 +275,7 @@ class ContinuousRun {
 }  // namespace
 
 SimulationSummary simulateContinuous(const Scenario& scenario, double step,
-                                     const SampleObserver& observer) {
+                                     const SampleObserver& observer, ContinuousMethod method) {
   const ControllerDesign design = ControllerDesign::create(scenario.controller);
   scenario.validate();
   if (scenario.formation.followers != 1) {
@@ -266,7 +290,11 @@ SimulationSummary simulateContinuous(const Scenario& scenario, double step,
     throw ParameterError("step", "must divide simulation.duration into a whole number of steps");
   }
   return visitDimensions(scenario.controller.model, [&](auto dims) {
-    ContinuousRun<decltype(dims)> run(scenario, design);
+    if (method == ContinuousMethod::kRungeKutta6) {
+      ContinuousRun<decltype(dims), ButcherRungeKutta6> run(scenario, design);
+      return run.run(step, observer);
+    }
+    ContinuousRun<decltype(dims), ClassicalRungeKutta4> run(scenario, design);
     return run.run(step, observer);
   });
 }

@@ -24,7 +24,8 @@ namespace projection_collision_avoidance {
 namespace {
 
 constexpr const char* kUsage =
-    "usage: cf_sim SCENARIO.yaml [--set key=value]... [--continuous STEP] [--csv FILE]\n"
+    "usage: cf_sim SCENARIO.yaml [--set key=value]... [--continuous STEP [--method rk4|rk6]]\n"
+    "              [--csv FILE]\n"
     "       cf_sim SCENARIO.yaml [--set key=value]... --sweep FILE [--directions N]\n"
     "              [--max-size S] [--size-step S] [--tolerance S]";
 
@@ -37,6 +38,7 @@ struct Options {
   std::string sweep_path;
   SweepOptions sweep;
   double continuous_step = 0.0;  // s; > 0: simulateContinuous() at this step
+  std::string method;            // "rk4" (default) or "rk6", with --continuous only
 };
 
 /// Parses a number option's value; false (with a message) if it is not one.
@@ -55,9 +57,9 @@ bool parseNumber(const std::string& option, const std::string& text, double* val
 }
 
 bool parseOptions(const std::vector<std::string>& arguments, Options* options, std::ostream& err) {
-  const std::vector<std::string> valued = {"--set",        "--csv",       "--sweep",
-                                           "--directions", "--max-size",  "--size-step",
-                                           "--tolerance",  "--continuous"};
+  const std::vector<std::string> valued = {"--set",        "--csv",        "--sweep",
+                                           "--directions", "--max-size",   "--size-step",
+                                           "--tolerance",  "--continuous", "--method"};
   for (std::size_t i = 0; i < arguments.size(); ++i) {
     const std::string& argument = arguments[i];
     bool takes_value = false;
@@ -77,6 +79,12 @@ bool parseOptions(const std::vector<std::string>& arguments, Options* options, s
         options->csv_path = value;
       } else if (argument == "--sweep") {
         options->sweep_path = value;
+      } else if (argument == "--method") {
+        if (value != "rk4" && value != "rk6") {
+          err << "cf_sim: --method is rk4 or rk6, got '" << value << "'\n";
+          return false;
+        }
+        options->method = value;
       } else if (!parseNumber(argument, value, &number, err)) {
         return false;
       } else if (argument == "--directions") {
@@ -117,6 +125,10 @@ bool parseOptions(const std::vector<std::string>& arguments, Options* options, s
   }
   if (!options->sweep_path.empty() && options->continuous_step > 0.0) {
     err << "cf_sim: --sweep and --continuous do not go together\n" << kUsage << "\n";
+    return false;
+  }
+  if (!options->method.empty() && !(options->continuous_step > 0.0)) {
+    err << "cf_sim: --method needs --continuous\n" << kUsage << "\n";
     return false;
   }
   if (!options->sweep_path.empty() && !options->csv_path.empty()) {
@@ -173,8 +185,10 @@ int runSimulation(const Scenario& scenario, const Options& options, std::ostream
     if (observer) {
       pair_observer = [&observer](const SimulationSample& sample) { observer(0, sample); };
     }
+    const ContinuousMethod method =
+        options.method == "rk6" ? ContinuousMethod::kRungeKutta6 : ContinuousMethod::kRungeKutta4;
     summary.followers.push_back(
-        simulateContinuous(scenario, options.continuous_step, pair_observer));
+        simulateContinuous(scenario, options.continuous_step, pair_observer, method));
   } else {
     summary = simulateFormation(scenario, observer);
   }

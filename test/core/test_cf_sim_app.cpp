@@ -94,6 +94,26 @@ TEST(CfSim, BadScenariosExitNonZeroNamingTheKey) {
   EXPECT_EQ(missing.code, 1);
 }
 
+TEST(CfSim, ChoosesTheContinuousMethod) {
+  const std::string scenario = scenarioPath("paper_run2.yaml");
+  const Result rk4 = runApp({scenario, "--continuous", "0.005"});
+  const Result rk6 = runApp({scenario, "--continuous", "0.02", "--method", "rk6"});
+  const Result rk4_named = runApp({scenario, "--continuous", "0.005", "--method", "rk4"});
+  ASSERT_EQ(rk4.code, 0) << rk4.err;
+  ASSERT_EQ(rk6.code, 0) << rk6.err;
+  ASSERT_EQ(rk4_named.code, 0) << rk4_named.err;
+  const auto a = parseSummary(rk4.out);
+  const auto b = parseSummary(rk6.out);
+  EXPECT_EQ(a.at("max_xi"), parseSummary(rk4_named.out).at("max_xi"));  // rk4 is the default
+  // Two methods at different steps, one model: the summaries agree to their print precision.
+  EXPECT_NEAR(a.at("max_xi"), b.at("max_xi"), 1e-7);
+  EXPECT_NEAR(a.at("min_separation"), b.at("min_separation"), 1e-7);
+  EXPECT_EQ(runApp({scenario, "--method", "rk6"}).code, 2);  // needs --continuous
+  const Result unknown = runApp({scenario, "--continuous", "0.01", "--method", "euler"});
+  EXPECT_EQ(unknown.code, 2);
+  EXPECT_NE(unknown.err.find("rk4 or rk6"), std::string::npos) << unknown.err;
+}
+
 TEST(CfSim, UsageErrorsExitWithTwo) {
   EXPECT_EQ(runApp({}).code, 2);
   EXPECT_EQ(runApp({scenarioPath("paper_run2.yaml"), "--set"}).code, 2);

@@ -22,20 +22,29 @@ namespace {
 
 using testing::scenarioPath;
 
-/// The samples of a run at the times of the 100 Hz grid.
-std::vector<SimulationSample> onGrid(const std::vector<SimulationSample>& samples, double step) {
+/// The samples of a run at the times of the grid of spacing @p grid (a multiple of the step).
+std::vector<SimulationSample> onGrid(const std::vector<SimulationSample>& samples, double step,
+                                     double grid) {
   std::vector<SimulationSample> result;
-  const long every = std::lround(0.01 / step);
+  const long every = std::lround(grid / step);
+  EXPECT_GE(every, 1) << "grid " << grid << " finer than the step " << step;
+  if (every < 1) {
+    return result;
+  }
   for (std::size_t k = 0; k < samples.size(); k += static_cast<std::size_t>(every)) {
     result.push_back(samples[k]);
   }
   return result;
 }
 
-std::vector<SimulationSample> continuousRun(const Scenario& scenario, double step) {
+/// A continuous run's samples on the 100 Hz grid (or the grid given).
+std::vector<SimulationSample> continuousRun(
+    const Scenario& scenario, double step, ContinuousMethod method = ContinuousMethod::kRungeKutta4,
+    double grid = 0.01) {
   std::vector<SimulationSample> samples;
-  simulateContinuous(scenario, step, [&](const SimulationSample& s) { samples.push_back(s); });
-  return onGrid(samples, step);
+  simulateContinuous(
+      scenario, step, [&](const SimulationSample& s) { samples.push_back(s); }, method);
+  return onGrid(samples, step, grid);
 }
 
 /// max over the common grid of ||xi - xi_ref|| and ||xi_hat - xi_hat_ref||.
@@ -97,6 +106,25 @@ TEST(ContinuousSimulator, ConvergesAtFourthOrderWhereSmooth) {
   }
 }
 
+// Butcher's 7-stage method: halving the step divides the error by about 2^6 = 64 on Run 2, and
+// both methods converge to the same solution.
+TEST(ContinuousSimulator, ConvergesAtSixthOrderWithButchersMethod) {
+  const Scenario scenario = loadScenarioFile(scenarioPath("paper_run2.yaml"));
+  const auto rk4 = ContinuousMethod::kRungeKutta4;
+  const auto rk6 = ContinuousMethod::kRungeKutta6;
+  const double grid = 0.1;  // 10 Hz, on which the coarse step of 0.05 s lands
+  const std::vector<SimulationSample> fine = continuousRun(scenario, 0.005, rk6, grid);
+  const double coarse_error = largestDifference(continuousRun(scenario, 0.05, rk6, grid), fine);
+  const double half_error = largestDifference(continuousRun(scenario, 0.025, rk6, grid), fine);
+  EXPECT_GT(coarse_error, 1e-9);  // far above the fine run's own error
+  EXPECT_GT(coarse_error / half_error, 40.0) << coarse_error << " then " << half_error;
+  EXPECT_LT(largestDifference(continuousRun(scenario, 0.000625, rk4, grid), fine), 1e-10);
+  const SimulationSummary s = simulateContinuous(scenario, 0.02, {}, rk6);
+  EXPECT_EQ(s.ticks, 3001);
+  EXPECT_NEAR(s.max_xi, 3.0, 0.15);
+  EXPECT_NEAR(s.min_separation, 3.9, 0.1);
+}
+
 // The sampled controller (zero-order hold) approaches the continuous loop as the rate grows,
 // at first order: within a few centimetres at 100 Hz and a few millimetres at 1 kHz (the
 // math note).
@@ -108,7 +136,7 @@ TEST(ContinuousSimulator, SampledControllerConvergesToIt) {
     scenario.controller.control_rate = rate;
     std::vector<SimulationSample> samples;
     simulate(scenario, [&](const SimulationSample& s) { samples.push_back(s); });
-    errors.push_back(largestDifference(onGrid(samples, 1.0 / rate), continuous));
+    errors.push_back(largestDifference(onGrid(samples, 1.0 / rate, 0.01), continuous));
   }
   EXPECT_LT(errors[0], 0.06);
   EXPECT_LT(errors[1], 0.006);
