@@ -182,7 +182,7 @@ FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh, const
     try {
       control_thread_.start(std::chrono::nanoseconds(std::llround(1e9 / parameters_.control_rate)),
                             priority, [this](const PeriodicTick& tick) { onLoopTick(tick); });
-    } catch (const std::system_error& error) {
+    } catch (const PriorityRefused& error) {
       throw ParameterError("~control_priority",
                            "SCHED_FIFO priority " + std::to_string(priority) +
                                " refused: pthread_setschedparam failed: " + error.code().message() +

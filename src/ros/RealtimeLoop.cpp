@@ -60,9 +60,8 @@ void PeriodicThread::start(std::chrono::nanoseconds period, int priority, Callba
   const int error = outcome.get();
   if (error != 0) {
     thread_.join();  // it has returned already
-    throw std::system_error(
-        error, std::generic_category(),
-        "pthread_setschedparam(SCHED_FIFO, priority " + std::to_string(priority) + ")");
+    throw PriorityRefused(
+        error, "pthread_setschedparam(SCHED_FIFO, priority " + std::to_string(priority) + ")");
   }
 }
 

@@ -217,13 +217,13 @@ TEST(PeriodicThread, PriorityRunsTheThreadUnderSchedFifo) {
   PeriodicThread thread;
   try {
     thread.start(milliseconds(5), priority, recorder.callback());
-  } catch (const std::system_error& error) {
+  } catch (const PriorityRefused& error) {
     EXPECT_FALSE(thread.running()) << "a refused priority must leave no thread behind";
     if (error.code() == std::errc::operation_not_permitted) {
       GTEST_SKIP() << "SCHED_FIFO refused here (EPERM: no CAP_SYS_NICE and RLIMIT_RTPRIO below "
                    << priority << "): " << error.what();
     }
-    FAIL() << "start() failed otherwise than EPERM: " << error.what();
+    FAIL() << "the priority was refused otherwise than with EPERM: " << error.what();
   }
   ASSERT_TRUE(recorder.waitFor(3));
   thread.stop();

@@ -10,6 +10,8 @@
 #include <cstdint>
 #include <functional>
 #include <future>
+#include <string>
+#include <system_error>
 #include <thread>
 
 namespace projection_collision_avoidance {
@@ -24,6 +26,14 @@ struct PeriodicTick {
   std::int64_t actual = 0;    ///< when the thread woke for it (>= expected)
   std::uint64_t skipped = 0;  ///< deadlines skipped just before this one (previous call overran)
   std::int64_t period = 0;    ///< the thread's period
+};
+
+/// The kernel refused a PeriodicThread its SCHED_FIFO priority; code() is the errno (EPERM without
+/// CAP_SYS_NICE or a high enough RLIMIT_RTPRIO).
+class PriorityRefused : public std::system_error {
+ public:
+  PriorityRefused(int error, const std::string& what)
+      : std::system_error(error, std::generic_category(), what) {}
 };
 
 /// A thread that calls a function at absolute deadlines start + k * period (k = 1, 2, ...),
@@ -55,8 +65,8 @@ class PeriodicThread {
   /// @param callback  what to run at each deadline
   /// @throws std::invalid_argument for a period <= 0, a priority outside [0, 99] or no callback
   /// @throws std::logic_error when the thread already runs
-  /// @throws std::system_error (code: the errno, e.g. EPERM without CAP_SYS_NICE or an
-  ///         RLIMIT_RTPRIO) when the priority is refused; the thread has then ended
+  /// @throws PriorityRefused when the priority is refused; the thread has then ended
+  /// @throws std::system_error when no thread can be created
   void start(std::chrono::nanoseconds period, int priority, Callback callback);
 
   /// Asks the thread to end and joins it; returns once it has ended. Does nothing when it does
