@@ -42,7 +42,7 @@ class PriorityRefused : public std::system_error {
 /// or the thread woke late), the deadlines already past are skipped, counted in the next call's
 /// PeriodicTick::skipped and in missedPeriods(), and the thread re-aligns to the next future one.
 ///
-/// stop() (or the destructor) ends the thread within max(one period, 10 ms) plus the running
+/// stop() (or the destructor) ends the thread within min(one period, 10 ms) plus the running
 /// call: the sleep is cut into slices of at most 10 ms between which a stop flag is checked.
 class PeriodicThread {
  public:
