@@ -76,7 +76,7 @@ echo "== 3/5 cf_sim against SciPy LSODA ($reps repetitions)" >&2
 if [ "$skip_ros" = 0 ]; then
   echo "== 4/5 ROS follower at 1 kHz ($ros_runs runs of $ros_duration s per setting)" >&2
   bash "$root/scripts/ros_latency.sh" --runs "$ros_runs" --duration "$ros_duration" --realtime \
-    --csv "$root/doc/ros_latency.csv" >/dev/null
+    --follower-thread --csv "$root/doc/ros_latency.csv" >/dev/null
 fi
 
 if [ "$with_scale" = 1 ]; then

@@ -4,14 +4,20 @@
 `run` launches test/performance/latency.launch RUNS times per setting, each on its own master
 (roslaunch -p PORT), and keeps the probe's JSON of each run; the settings are the machine as it
 is ("as is") and with one nice-19 busy loop per core ("keep-awake": on this Firecracker VM an
-idle core halts and wakes late, which delays timers and message deliveries), and with --realtime
+idle core halts and wakes late, which delays timers and message deliveries), with --realtime
 also every node under SCHED_FIFO with the cores kept awake ("keep-awake, SCHED_FIFO": probe,
-relay and both followers alike, through the launch's launch_prefix). Then it writes the
-raw per-run figures to CSV and prints a Markdown table of medians over the runs of each setting.
+relay and both followers alike, through the launch's launch_prefix), and with --follower-thread
+the followers' control tick on their real-time thread with the cores kept awake
+("keep-awake, control thread": ~control_loop thread, ~control_priority 80, ~lock_memory true;
+probe and relay as in keep-awake). Then it writes the raw per-run figures to CSV and prints a
+Markdown table of medians over the runs of each setting.
 
 Usage: ros_latency.py --runs N --duration S --rate HZ --keep-awake none|both|all [--realtime]
+                      [--follower-thread] [--only SETTING[,SETTING...]]
                       --csv doc/ros_latency.csv --port 11421 --work DIR
   --keep-awake none: as is only; all: keep-awake only; both: as is, then keep-awake.
+  --only: exactly these settings (of as-is, keep-awake, realtime, follower-thread), in the
+          order given, whatever --keep-awake, --realtime and --follower-thread say.
 """
 
 import argparse
@@ -34,6 +40,16 @@ TARGET_ADDED_PERCENT = 20.0  # latency the measurement-triggered follower adds t
 
 
 REALTIME_PRIORITY = 50  # SCHED_FIFO priority of every node in the realtime setting
+FOLLOWER_THREAD_PRIORITY = 80  # ~control_priority of the followers in the follower-thread setting
+
+# The settings: (key for --only, name in the table and CSV, cores kept awake, every node under
+# chrt -f REALTIME_PRIORITY, followers on ~control_loop thread).
+SETTINGS = (
+    ("as-is", "as is", False, False, False),
+    ("keep-awake", "keep-awake", True, False, False),
+    ("realtime", "keep-awake, SCHED_FIFO", True, True, False),
+    ("follower-thread", "keep-awake, control thread", True, False, True),
+)
 
 
 def log(*words):
@@ -52,7 +68,7 @@ def loadavg():
         return float(f.read().split()[0])
 
 
-def run_one(args, setting, index, realtime=False):
+def run_one(args, setting, index, realtime=False, follower_thread=False):
     """One launch; returns the CSV row (ok False when the probe wrote nothing usable)."""
     tag = "%s_%d" % (setting.replace(", ", "_").replace(" ", "_").replace("-", "_"), index)
     output = os.path.join(args.work, tag + ".json")
@@ -65,6 +81,9 @@ def run_one(args, setting, index, realtime=False):
                "rate:=%g" % args.rate, "control_rate:=%g" % args.rate, "output:=%s" % output]
     if realtime:
         command.append("launch_prefix:=chrt -f %d" % REALTIME_PRIORITY)
+    if follower_thread:
+        command += ["control_loop:=thread", "control_priority:=%d" % FOLLOWER_THREAD_PRIORITY,
+                    "lock_memory:=true"]
     row = {"setting": setting, "run": index, "duration_s": args.duration, "rate_hz": args.rate,
            "load1_before": loadavg(), "ok": False}
     total0, steal0 = cpu_times()
@@ -118,21 +137,26 @@ def run_one(args, setting, index, realtime=False):
     return row
 
 
+def chosen_settings(args):
+    """The SETTINGS entries to run, in order."""
+    if args.only:
+        return [next(s for s in SETTINGS if s[0] == key) for key in args.only]
+    keys = {"none": ["as-is"], "all": ["keep-awake"], "both": ["as-is", "keep-awake"]}[
+        args.keep_awake]
+    keys += ["realtime"] * args.realtime + ["follower-thread"] * args.follower_thread
+    return [s for key in keys for s in SETTINGS if s[0] == key]
+
+
 def run(args):
     os.makedirs(args.work, exist_ok=True)
-    settings = [(False, False), (True, False)]
-    settings = {"none": settings[:1], "all": settings[1:], "both": settings}[args.keep_awake]
-    if args.realtime:
-        settings.append((True, True))
     rows = []
-    for awake, realtime in settings:
-        setting = "keep-awake, SCHED_FIFO" if realtime else ("keep-awake" if awake else "as is")
+    for _, setting, awake, realtime, follower_thread in chosen_settings(args):
         spinners = start_spinners() if awake else []
         try:
             for index in range(1, args.runs + 1):
                 log("%s, run %d of %d: %g s at %g Hz (load average %.2f)"
                     % (setting, index, args.runs, args.duration, args.rate, loadavg()))
-                row = run_one(args, setting, index, realtime)
+                row = run_one(args, setting, index, realtime, follower_thread)
                 rows.append(row)
                 if row["ok"]:
                     log("  relay p50 %.0f / p99 %.0f us; measurement-triggered p50 %.0f / p99 %.0f "
@@ -242,12 +266,23 @@ def main():
     parser.add_argument("--realtime", action="store_true",
                         help="also run every node under SCHED_FIFO (chrt -f %d), cores kept awake"
                         % REALTIME_PRIORITY)
+    parser.add_argument("--follower-thread", action="store_true",
+                        help="also run the followers on their real-time control thread "
+                        "(~control_loop thread, ~control_priority %d, ~lock_memory true), cores "
+                        "kept awake" % FOLLOWER_THREAD_PRIORITY)
+    parser.add_argument("--only", type=lambda text: text.split(","), default=None,
+                        metavar="SETTING[,SETTING...]",
+                        help="exactly these settings: " + ", ".join(s[0] for s in SETTINGS))
     parser.add_argument("--csv", default=os.path.join(ROOT, "doc", "ros_latency.csv"))
     parser.add_argument("--port", type=int, default=11421)
     parser.add_argument("--work", required=True)
     args = parser.parse_args()
     if args.runs < 1 or args.duration <= 0 or args.rate <= 0:
         parser.error("--runs >= 1, --duration > 0 and --rate > 0")
+    unknown = [key for key in args.only or [] if key not in [s[0] for s in SETTINGS]]
+    if unknown or args.only == [""]:
+        parser.error("--only: unknown setting(s) %s; choose from %s"
+                     % (", ".join(unknown) or "''", ", ".join(s[0] for s in SETTINGS)))
     return run(args)
 
 

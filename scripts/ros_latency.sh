@@ -8,6 +8,7 @@
 # follower p50/p99 and its added latency over the relay of the same run, timer follower p50/p99,
 # missed and late periods in %) and writes the raw per-run figures to CSV.
 # Usage: scripts/ros_latency.sh [--runs N] [--duration S] [--keep-awake none|both|all] [--realtime]
+#                               [--follower-thread] [--only SETTING[,SETTING...]]
 #                               [--csv FILE] [--rate HZ] [--port PORT] [--work DIR]
 #   --runs      launches per setting (default 3)
 #   --duration  measured seconds per launch (default 60; plus ~10 s of start-up and warm-up)
@@ -16,6 +17,13 @@
 #               timers and deliveries); both (default): as is, then kept awake
 #   --realtime  also a setting with every node (probe, relay, followers) under SCHED_FIFO
 #               priority 50 (chrt; needs root or CAP_SYS_NICE) and the cores kept awake
+#   --follower-thread  also a setting with both followers' control tick on their real-time thread
+#               (~control_loop thread, ~control_priority 80, ~lock_memory true; needs root or
+#               CAP_SYS_NICE and CAP_IPC_LOCK), the cores kept awake, probe and relay as in
+#               keep-awake
+#   --only      exactly these settings, in the order given, of as-is, keep-awake, realtime,
+#               follower-thread (comma-separated; overrides --keep-awake, --realtime and
+#               --follower-thread), e.g. --only follower-thread
 #   --csv       raw per-run figures (default doc/ros_latency.csv)
 #   --rate      Hz of the measurements and of control_rate (default 1000)
 #   --port      ROS master port (default 11421)
@@ -33,6 +41,8 @@ rate=1000
 port=11421
 work=
 realtime=()
+follower_thread=()
+only=()
 while (($#)); do
   case $1 in
     --runs) runs=$2; shift 2 ;;
@@ -43,6 +53,8 @@ while (($#)); do
     --port) port=$2; shift 2 ;;
     --work) work=$2; shift 2 ;;
     --realtime) realtime=(--realtime); shift ;;
+    --follower-thread) follower_thread=(--follower-thread); shift ;;
+    --only) only=(--only "$2"); shift 2 ;;
     -h|--help) sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0 ;;
     *) echo "ros_latency.sh: unknown argument $1 (see --help)" >&2; exit 2 ;;
   esac
@@ -62,4 +74,4 @@ export ROS_MASTER_URI=http://localhost:$port
 echo "ros_latency: work directory (probe JSON, launch and ROS logs): $work" >&2
 /usr/bin/python3 "$root/scripts/ros_latency.py" --runs "$runs" --duration "$duration" \
   --rate "$rate" --keep-awake "$keep_awake" --csv "$csv" --port "$port" --work "$work" \
-  "${realtime[@]}"
+  "${realtime[@]}" "${follower_thread[@]}" "${only[@]}"

@@ -1,10 +1,12 @@
 #include "projection_collision_avoidance/ros/FollowerNode.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <iomanip>
 #include <limits>
 #include <sstream>
+#include <system_error>
 
 #include <geometry_msgs/AccelStamped.h>
 #include <visualization_msgs/MarkerArray.h>
@@ -61,8 +63,25 @@ ControlTrigger triggerOf(const std::string& value) {
   throw ParameterError("~trigger", "must be \"timer\" or \"measurement\", got \"" + value + "\"");
 }
 
+/// ~control_loop; "thread" is refused on simulated time (@p sim_time).
+ControlLoop controlLoopOf(const std::string& value, bool sim_time) {
+  if (value == "timer") {
+    return ControlLoop::kTimer;
+  }
+  if (value == "thread") {
+    if (sim_time) {
+      throw ParameterError("~control_loop",
+                           "\"thread\" sleeps on the monotonic clock and cannot follow simulated "
+                           "time (/use_sim_time is true): use \"timer\"");
+    }
+    return ControlLoop::kThread;
+  }
+  throw ParameterError("~control_loop", "must be \"timer\" or \"thread\", got \"" + value + "\"");
+}
+
+/// The node's options; @p sim_time: whether ROS time is simulated (/use_sim_time).
 FollowerNodeOptions readOptions(NodeOptionReader& reader, const ControllerParameters& p,
-                                const FormationMember& member) {
+                                const FormationMember& member, bool sim_time) {
   FollowerNodeOptions options;
   options.formation_index = member.index;
   const double period = 1.0 / p.control_rate;
@@ -80,6 +99,17 @@ FollowerNodeOptions readOptions(NodeOptionReader& reader, const ControllerParame
   }
   options.marker_rate = reader.number("marker_rate", options.marker_rate, 0.0, p.control_rate);
   options.trigger = triggerOf(reader.text("trigger", toString(options.trigger)));
+  options.control_loop =
+      controlLoopOf(reader.text("control_loop", toString(options.control_loop)), sim_time);
+  options.control_priority =
+      reader.integer("control_priority", options.control_priority, 0, kMaxControlPriority);
+  if (options.control_priority > 0 && options.control_loop != ControlLoop::kThread) {
+    throw ParameterError("~control_priority",
+                         "is " + std::to_string(options.control_priority) +
+                             " but only the \"thread\" control loop has a priority: set "
+                             "~control_loop to \"thread\", or this to 0");
+  }
+  options.lock_memory = reader.boolean("lock_memory", options.lock_memory);
   return options;
 }
 
@@ -88,6 +118,8 @@ FollowerNodeOptions readOptions(NodeOptionReader& reader, const ControllerParame
 const char* toString(ControlTrigger trigger) {
   return trigger == ControlTrigger::kMeasurement ? "measurement" : "timer";
 }
+
+const char* toString(ControlLoop loop) { return loop == ControlLoop::kThread ? "thread" : "timer"; }
 
 FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
     : FollowerNode(nh, private_nh, loadDoubleIntegratorScenario(private_nh)) {}
@@ -105,7 +137,18 @@ FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh, const
       diagnostics_(nh, private_nh),
       reconfigure_server_(reconfigure_mutex_, private_nh) {
   NodeOptionReader& reader = reader_;
-  options_ = readOptions(reader, parameters_, member_);
+  options_ = readOptions(reader, parameters_, member_, ros::Time::isSimTime());
+  if (options_.lock_memory) {
+    try {
+      lockProcessMemory();
+    } catch (const std::system_error& error) {
+      throw ParameterError(
+          "~lock_memory",
+          "is true but mlockall(MCL_CURRENT | MCL_FUTURE) failed: " + error.code().message() +
+              " (needs root or CAP_IPC_LOCK, or an RLIMIT_MEMLOCK above the "
+              "process's size)");
+    }
+  }
   measurement_guard_ =
       InputGuard("relative_measurement", options_.measurement_frame, options_.max_future_stamp);
   leader_guard_ =
@@ -133,22 +176,45 @@ FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh, const
   reconfigure_server_.setCallback(
       [this](FollowerConfig& config, uint32_t level) { onReconfigure(config, level); });
 
-  ros::TimerOptions timer_options(
-      ros::Duration(1.0 / parameters_.control_rate),
-      [this](const ros::TimerEvent& event) { onControlTick(event); }, &control_queue_);
-  timer_ = nh_.createTimer(timer_options);
-  control_spinner_ = std::make_unique<ros::AsyncSpinner>(1, &control_queue_);
-  control_spinner_->start();
+  std::ostringstream loop;
+  if (options_.control_loop == ControlLoop::kThread) {
+    const int priority = options_.control_priority;
+    try {
+      control_thread_.start(std::chrono::nanoseconds(std::llround(1e9 / parameters_.control_rate)),
+                            priority, [this](const PeriodicTick& tick) { onLoopTick(tick); });
+    } catch (const PriorityRefused& error) {
+      throw ParameterError("~control_priority",
+                           "SCHED_FIFO priority " + std::to_string(priority) +
+                               " refused: pthread_setschedparam failed: " + error.code().message() +
+                               " (needs root or CAP_SYS_NICE, or an RLIMIT_RTPRIO of at least " +
+                               std::to_string(priority) + "; 0 runs without real-time priority)");
+    }
+    loop << ", control loop: thread"
+         << (priority > 0 ? ", SCHED_FIFO " + std::to_string(priority) : std::string());
+  } else {
+    ros::TimerOptions timer_options(
+        ros::Duration(1.0 / parameters_.control_rate),
+        [this](const ros::TimerEvent& event) { onControlTick(event); }, &control_queue_);
+    timer_ = nh_.createTimer(timer_options);
+    control_spinner_ = std::make_unique<ros::AsyncSpinner>(1, &control_queue_);
+    control_spinner_->start();
+  }
+  if (options_.lock_memory) {
+    loop << ", memory locked";
+  }
   ROS_INFO_STREAM(name << ": " << member_.name << " looking at " << member_.target_name << ", d = ["
                        << parameters_.separation.transpose() << "], running at "
                        << parameters_.control_rate << " Hz (trigger: " << toString(options_.trigger)
-                       << "), " << axes_ << " axes, xi_max " << controller_.design().xi_max
-                       << " m");
+                       << loop.str() << "), " << axes_ << " axes, xi_max "
+                       << controller_.design().xi_max << " m");
 }
 
 FollowerNode::~FollowerNode() {
+  control_thread_.stop();  // "thread": ends within one period (at most 10 ms) and a tick
   timer_.stop();
-  control_spinner_->stop();
+  if (control_spinner_) {
+    control_spinner_->stop();
+  }
 }
 
 void FollowerNode::onMeasurement(const RelativeMeasurement::ConstPtr& msg) {
@@ -224,13 +290,31 @@ void FollowerNode::onControlTick(const ros::TimerEvent& event) {
   const std::lock_guard<std::mutex> lock(mutex_);
   const ros::Time now = ros::Time::now();
   const double delay = (event.current_real - event.current_expected).toSec();
+  std::uint32_t skipped = 0;
   if (options_.trigger == ControlTrigger::kTimer) {
     if (have_last_expected_) {
-      addSaturated(&missed_periods_,
-                   skippedPeriods((event.current_expected - last_expected_).toSec(), period_));
+      skipped = skippedPeriods((event.current_expected - last_expected_).toSec(), period_);
     }
     last_expected_ = event.current_expected;
     have_last_expected_ = true;
+  }
+  controlTick(now, delay, skipped);
+}
+
+void FollowerNode::onLoopTick(const PeriodicTick& tick) {
+  if (!ros::ok()) {  // shutting down: the timer's spinner would not call it either
+    return;
+  }
+  const std::lock_guard<std::mutex> lock(mutex_);
+  const ros::Time now = ros::Time::now();
+  const double delay = 1e-9 * static_cast<double>(tick.actual - tick.expected);
+  const std::uint64_t most = std::numeric_limits<std::uint32_t>::max();
+  controlTick(now, delay, static_cast<std::uint32_t>(std::min(tick.skipped, most)));
+}
+
+void FollowerNode::controlTick(const ros::Time& now, double delay, std::uint32_t skipped) {
+  if (options_.trigger == ControlTrigger::kTimer) {
+    addSaturated(&missed_periods_, skipped);
     controlStep(now, delay);
     return;
   }
@@ -431,6 +515,9 @@ void FollowerNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
   status.add("leader_age (s)",
              leader_guard_.haveAccepted() ? (now - leader_guard_.lastStamp()).toSec() : -1.0);
   status.add("trigger", toString(options_.trigger));
+  status.add("control_loop", toString(options_.control_loop));
+  status.add("control_priority", options_.control_priority);
+  status.add("lock_memory", options_.lock_memory);
   status.add("ticks", ticks_);
   status.add("missed_periods", missed_periods_);
   status.add("late_periods", late_periods_);

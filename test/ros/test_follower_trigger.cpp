@@ -6,9 +6,11 @@
 ///   ~fallback_ticks       timer steps to see once the measurement is stale
 ///   ~max_tick_delay       s; bound on a measurement step's tick_delay (now - stamp at its start)
 ///   ~wall_deadline        wall seconds to wait for each condition
+///   ~control_loop         the follower's ~control_loop ("timer" or "thread"), for its diagnostics
 
 #include <algorithm>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include <geometry_msgs/AccelStamped.h>
@@ -174,6 +176,30 @@ TEST_F(FollowerTriggerTest, StaleMeasurementBrakesOnTheTimerUntilTheNextOne) {
   const std::lock_guard<std::mutex> lock(mutex_);
   EXPECT_EQ(statusAt(again)->mode, FollowerStatus::MODE_TRACKING);
   EXPECT_FALSE(statusAt(again)->fallback);
+}
+
+TEST_F(FollowerTriggerTest, DiagnosticsNameTheTriggerAndTheLoop) {
+  ASSERT_TRUE(connected()) << "the follower and the test never connected";
+  std::string loop;
+  ASSERT_TRUE(private_nh_.getParam("control_loop", loop)) << "missing test parameter ~control_loop";
+  const auto value = [](const diagnostic_msgs::DiagnosticStatus& status, const std::string& key) {
+    for (const auto& entry : status.values) {
+      if (entry.key == key) {
+        return entry.value;
+      }
+    }
+    return std::string("(missing)");
+  };
+  EXPECT_TRUE(waitFor(
+      [&] {
+        return std::any_of(follower_diagnostics_.begin(), follower_diagnostics_.end(),
+                           [&](const diagnostic_msgs::DiagnosticStatus& status) {
+                             return value(status, "trigger") == "measurement" &&
+                                    value(status, "control_loop") == loop;
+                           });
+      },
+      param("wall_deadline")))
+      << "no diagnostics with trigger measurement and control_loop " << loop;
 }
 
 }  // namespace

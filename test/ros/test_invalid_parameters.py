@@ -485,6 +485,11 @@ def opt(name, node, key, value):
     return case(name, "~" + key, options={key: value}, nodes=(node,))
 
 
+def on_thread(name, key, value):
+    """A follower option spoiled on a follower with ~control_loop thread."""
+    return case(name, "~" + key, options={"control_loop": "thread", key: value}, nodes=(FOLLOWER,))
+
+
 NODE_OPTIONS = [
     # follower_node
     opt("measurement_timeout < 0", FOLLOWER, "measurement_timeout", -1.0),
@@ -520,6 +525,21 @@ NODE_OPTIONS = [
     opt("trigger capitalised", FOLLOWER, "trigger", "Timer"),
     opt("trigger a number", FOLLOWER, "trigger", 1),
     opt("trigger a boolean", FOLLOWER, "trigger", True),
+    opt("control_loop unknown", FOLLOWER, "control_loop", "realtime"),
+    opt("control_loop empty", FOLLOWER, "control_loop", ""),
+    opt("control_loop capitalised", FOLLOWER, "control_loop", "Thread"),
+    opt("control_loop a number", FOLLOWER, "control_loop", 1),
+    opt("control_loop a boolean", FOLLOWER, "control_loop", True),
+    on_thread("control_priority 100", "control_priority", 100),
+    on_thread("control_priority -1", "control_priority", -1),
+    on_thread("control_priority not whole", "control_priority", 50.5),
+    on_thread("control_priority a string", "control_priority", "80"),
+    on_thread("control_priority a boolean", "control_priority", True),
+    opt("control_priority without ~control_loop", FOLLOWER, "control_priority", 80),
+    case("control_priority with ~control_loop timer", "~control_priority",
+         options={"control_loop": "timer", "control_priority": 1}, nodes=(FOLLOWER,)),
+    opt("lock_memory a string", FOLLOWER, "lock_memory", "true"),
+    opt("lock_memory an integer", FOLLOWER, "lock_memory", 1),
     # plant_node
     opt("rate < 0", PLANT, "rate", -1.0),
     opt("rate = 0", PLANT, "rate", 0),
@@ -617,13 +637,14 @@ class InvalidParameters(unittest.TestCase):
         return name
 
     @staticmethod
-    def run_node(executable, name, deadline=DEADLINE):
-        """Runs a node until it exits, logs that it runs (then it is stopped) or the deadline
-        passes (then it is killed). The outcome is "exited", "running" or "hung"."""
+    def run_node(executable, name, deadline=DEADLINE, prefix=()):
+        """Runs a node (after the command @p prefix, if any) until it exits, logs that it runs
+        (then it is stopped) or the deadline passes (then it is killed). The outcome is
+        "exited", "running" or "hung"."""
         start = time.monotonic()
         # Line-buffered stdout, so that "running" is seen as soon as it is logged.
         environment = dict(os.environ, ROSCONSOLE_STDOUT_LINE_BUFFERED="1")
-        process = subprocess.Popen([node_executable(executable), f"__name:={name}"],
+        process = subprocess.Popen([*prefix, node_executable(executable), f"__name:={name}"],
                                    stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
                                    errors="replace", env=environment)
         lines = []
@@ -656,8 +677,9 @@ class InvalidParameters(unittest.TestCase):
         reader.join(timeout=5.0)
         return Result(outcome, process.returncode, "".join(lines), seconds)
 
-    def run_cases(self, cases, expect_running=False):
-        """Runs every (case, node) pair, several at a time; returns [(case, node, result)]."""
+    def run_cases(self, cases, prefix=()):
+        """Runs every (case, node) pair, several at a time, each after the command @p prefix;
+        returns [(case, node, result)]."""
         jobs = []
         for c in cases:
             for node in c.nodes:
@@ -670,12 +692,15 @@ class InvalidParameters(unittest.TestCase):
                     scenario = os.path.join(self.directory, scenario[1:])
                 jobs.append((c, node, self.prepare(node, scenario, c.options)))
         with ThreadPoolExecutor(max_workers=PARALLEL) as pool:
-            results = list(pool.map(lambda job: self.run_node(job[1], job[2]), jobs))
+            results = list(pool.map(lambda job: self.run_node(job[1], job[2], prefix=prefix),
+                                    jobs))
         return [(c, node, result) for (c, node, _), result in zip(jobs, results)]
 
-    def check_refused(self, cases):
+    def check_refused(self, cases, prefix=(), reasons=()):
+        """Every run of @p cases must exit 1 naming the key (and, given @p reasons, with one of
+        them in its output)."""
         failures = []
-        runs = self.run_cases(cases)
+        runs = self.run_cases(cases, prefix)
         for c, node, r in runs:
             expected = f"invalid parameter {c.key}: "
             problem = None
@@ -691,6 +716,8 @@ class InvalidParameters(unittest.TestCase):
                 problem = f"exited {r.code}, expected 1"
             elif expected not in r.output:
                 problem = f"the message does not name {c.key}"
+            elif reasons and not any(reason in r.output for reason in reasons):
+                problem = f"the message gives none of the reasons {reasons}"
             if problem:
                 output = r.output if len(r.output) < 2000 else r.output[-2000:]
                 failures.append(f"[{node}] {c.name}: {problem}\n{output.rstrip()}")
@@ -722,6 +749,53 @@ class InvalidParameters(unittest.TestCase):
 
     def test_bad_node_option(self):
         self.check_refused(NODE_OPTIONS)
+
+    def test_thread_loop_refused_on_simulated_time(self):
+        """~control_loop thread sleeps on the monotonic clock: with /use_sim_time true the
+        follower refuses it naming ~control_loop (the timer loop still starts). /use_sim_time is
+        global, so this runs alone and restores it."""
+        previous = rospy.get_param("/use_sim_time", None)
+        rospy.set_param("/use_sim_time", True)
+        try:
+            self.check_refused([
+                case("control_loop thread on simulated time", "~control_loop",
+                     options={"control_loop": "thread"}, nodes=(FOLLOWER,)),
+                case("control_loop thread on simulated time, trigger measurement",
+                     "~control_loop", options={"control_loop": "thread",
+                                               "trigger": "measurement"}, nodes=(FOLLOWER,)),
+            ])
+            c = case("control_loop timer on simulated time", None,
+                     options={"control_loop": "timer"}, nodes=(FOLLOWER,))
+            [(_, _, r)] = self.run_cases([c])
+            self.assertEqual(r.outcome, "running", r.output)
+        finally:
+            if previous is None:
+                rospy.delete_param("/use_sim_time")
+            else:
+                rospy.set_param("/use_sim_time", previous)
+
+    def test_realtime_refused_by_the_kernel(self):
+        """A real-time request the kernel refuses ends the follower naming the parameter and the
+        reason, rather than running without it: the node runs without CAP_SYS_NICE and
+        CAP_IPC_LOCK (setpriv), with RLIMIT_RTPRIO 0 and a 64 KiB RLIMIT_MEMLOCK (prlimit)."""
+        prefix = ("setpriv", "--inh-caps=-sys_nice,-ipc_lock",
+                  "--bounding-set=-sys_nice,-ipc_lock", "prlimit", "--rtprio=0:0",
+                  "--memlock=65536:65536")
+        if not all(shutil.which(tool) for tool in ("setpriv", "prlimit")):
+            self.skipTest("setpriv and prlimit (util-linux) are needed to drop the privileges")
+        if subprocess.run([*prefix, "true"], capture_output=True).returncode != 0:
+            self.skipTest("cannot drop CAP_SYS_NICE / CAP_IPC_LOCK here (setpriv needs "
+                          "CAP_SETPCAP)")
+        cases = [
+            case("control_priority 80 without CAP_SYS_NICE", "~control_priority",
+                 options={"control_loop": "thread", "control_priority": 80},
+                 nodes=(FOLLOWER,)),
+            case("lock_memory without CAP_IPC_LOCK", "~lock_memory",
+                 options={"lock_memory": True}, nodes=(FOLLOWER,)),
+        ]
+        # The reason is the kernel's (strerror of EPERM or ENOMEM), not a generic failure.
+        self.check_refused(cases, prefix,
+                           reasons=("Operation not permitted", "Cannot allocate memory"))
 
     # --- valid parameters are accepted ---------------------------------------------------------
 
@@ -760,6 +834,14 @@ class InvalidParameters(unittest.TestCase):
         for trigger in ("timer", "measurement"):
             cases.append(case("trigger " + trigger, None, options={"trigger": trigger},
                               nodes=(FOLLOWER,)))
+            # The thread loop starts, and stops cleanly on SIGINT (checked below).
+            cases.append(case("trigger %s, control_loop thread" % trigger, None,
+                              options={"trigger": trigger, "control_loop": "thread",
+                                       "control_priority": 0, "lock_memory": False},
+                              nodes=(FOLLOWER,)))
+        cases.append(case("control_loop timer, priority 0", None,
+                          options={"control_loop": "timer", "control_priority": 0},
+                          nodes=(FOLLOWER,)))
         failures = []
         for c, node, r in self.run_cases(cases):
             if r.outcome != "running":

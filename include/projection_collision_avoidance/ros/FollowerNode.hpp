@@ -20,6 +20,7 @@
 #include "projection_collision_avoidance/RuntimeFollowerController.hpp"
 #include "projection_collision_avoidance/Scenario.hpp"
 #include "projection_collision_avoidance/ros/InputGuard.hpp"
+#include "projection_collision_avoidance/ros/RealtimeLoop.hpp"
 #include "projection_collision_avoidance/ros/RosParameters.hpp"
 
 namespace projection_collision_avoidance {
@@ -32,6 +33,18 @@ enum class ControlTrigger : std::uint8_t {
 
 /// "timer" or "measurement".
 const char* toString(ControlTrigger trigger);
+
+/// What runs the follower's fixed-rate control tick (~control_loop).
+enum class ControlLoop : std::uint8_t {
+  kTimer,   ///< "timer": a ros::Timer on a callback queue and spinner thread of its own
+  kThread,  ///< "thread": a PeriodicThread sleeping to absolute CLOCK_MONOTONIC deadlines
+};
+
+/// "timer" or "thread".
+const char* toString(ControlLoop loop);
+
+/// Highest ~control_priority (SCHED_FIFO's highest priority on Linux).
+constexpr int kMaxControlPriority = 99;
 
 /// The follower node's own options (besides the scenario), read once from its private namespace.
 struct FollowerNodeOptions {
@@ -46,6 +59,13 @@ struct FollowerNodeOptions {
   int formation_index = 1;     ///< i: which follower of the scenario's formation this is
   /// ~trigger: "timer" (default) or "measurement"; see FollowerNode.
   ControlTrigger trigger = ControlTrigger::kTimer;
+  /// ~control_loop: "timer" (default) or "thread" (wall time only); see FollowerNode.
+  ControlLoop control_loop = ControlLoop::kTimer;
+  /// ~control_priority: SCHED_FIFO priority of the control thread, 1 to 99; 0 (default) leaves
+  /// the scheduler alone. Only with control_loop "thread".
+  int control_priority = 0;
+  /// ~lock_memory: mlockall(MCL_CURRENT | MCL_FUTURE) at start (default false).
+  bool lock_memory = false;
 };
 
 /// ROS wrapper of RuntimeFollowerController: translates messages and time, nothing else.
@@ -80,6 +100,16 @@ struct FollowerNodeOptions {
 /// round(gap / T) - 1; "measurement": the same on the stamps of consecutive accepted
 /// measurements), late_periods (steps that started more than T / 2 after they were due: the
 /// timer's expected time, or the measurement's stamp) and tick_delay (start - due time).
+///
+/// ~control_loop decides what runs the fixed-rate tick. "timer" (default): a ros::Timer on a
+/// callback queue served by a spinner thread of its own (ROS time; simulated time works).
+/// "thread": a PeriodicThread (RealtimeLoop.hpp) that sleeps with clock_nanosleep to absolute
+/// CLOCK_MONOTONIC deadlines k / control_rate from its start and runs the same tick at each,
+/// stamped with ros::Time::now(); refused under /use_sim_time. Its missed periods ("timer"
+/// trigger) are the deadlines it skipped because a tick overran or woke late (it re-aligns to the
+/// next deadline ahead), its delay the wake-up time minus the deadline. ~control_priority (1 to
+/// 99) runs that thread under SCHED_FIFO, ~lock_memory locks the process's memory
+/// (mlockall); the node exits, naming the parameter, if the kernel refuses either.
 class FollowerNode {
  public:
   /// @throws ParameterError naming the parameter when the scenario or an option is invalid
@@ -91,7 +121,14 @@ class FollowerNode {
  private:
   void onMeasurement(const RelativeMeasurement::ConstPtr& msg);
   void onLeaderBroadcast(const LeaderBroadcast::ConstPtr& msg);
+  /// The timer's tick ("timer" loop).
   void onControlTick(const ros::TimerEvent& event);
+  /// The control thread's tick ("thread" loop).
+  void onLoopTick(const PeriodicTick& tick);
+  /// The tick of either loop (mutex_ held), @p delay s after it was due, @p skipped periods
+  /// after the previous one ("timer" trigger: counted as missed; "measurement": the steps run
+  /// on the measurements, the tick only brakes once they are stale, else updates diagnostics).
+  void controlTick(const ros::Time& now, double delay, std::uint32_t skipped);
   /// The mode the inputs' ages give at @p now; fills @p ages.
   FollowerMode modeAt(const ros::Time& now, FollowerInputAges* ages) const;
   /// One control step stamped @p stamp (mutex_ held), @p delay s after it was due: mode, laws,
@@ -146,6 +183,8 @@ class FollowerNode {
   FollowerConfig applied_config_;  ///< the reconfigure values in force
   boost::recursive_mutex reconfigure_mutex_;
   dynamic_reconfigure::Server<FollowerConfig> reconfigure_server_;
+  /// The "thread" loop: started last in the constructor, stopped first in the destructor.
+  PeriodicThread control_thread_;
 };
 
 }  // namespace projection_collision_avoidance
