@@ -1,24 +1,20 @@
 #!/usr/bin/env bash
-# Installs the Debian 12 packages this package needs that are missing, and nothing else.
-# Usage: scripts/setup.sh [--workspace-tools]
-#   --workspace-tools  also catkin-tools and colcon, for the catkin workspace builds
+# Installs the Debian 12 packages of scripts/debian-packages.txt that are missing, and nothing else.
+# Usage: scripts/setup.sh [--list]
+#   --list  print the packages and exit
 # Runs apt-get as root, through sudo when not root.
 set -euo pipefail
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 
-packages=(
-  build-essential cmake pkg-config git
-  catkin python3-catkin-pkg catkin-lint
-  libeigen3-dev libyaml-cpp-dev libyaml-dev
-  googletest libgtest-dev libbenchmark-dev
-  clang libclang-rt-14-dev llvm  # scripts/sanitize.sh: ASan, UBSan, libFuzzer, llvm-symbolizer
-  python3-yaml python3-numpy python3-scipy python3-matplotlib
-  ros-core-dev libtf2-ros-dev libtf2-eigen-dev libdiagnostic-updater-dev
-  libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure
-  libnodeletlib-dev libnodeletlib-tools pluginlib-dev
-  python3-rostest python3-rosbag librosbag-dev rviz xvfb
-)
-if [[ "${1:-}" == "--workspace-tools" ]]; then
-  packages+=(catkin-tools colcon python3-colcon-ros)
+# The first word of each line that is not a comment.
+mapfile -t packages < <(sed -e 's/#.*//' -e '/^[[:space:]]*$/d' "$root/scripts/debian-packages.txt" |
+  awk '{print $1}')
+if [[ "${1:-}" == "--list" ]]; then
+  printf '%s\n' "${packages[@]}"
+  exit 0
+elif [[ $# -gt 0 ]]; then
+  echo "usage: scripts/setup.sh [--list]" >&2
+  exit 2
 fi
 
 missing=()

@@ -2,14 +2,15 @@
 # Sets up, builds and runs every test; exits non-zero if anything fails.
 #  1. standalone build (cmake + make), all tests (gtest + cross-check with the SciPy reference),
 #     read back with catkin_test_results;
-#  2. the everyday ROS routes: the package in a fresh workspace built with catkin_make and with
-#     catkin build (catkin-tools);
+#  2. the everyday ROS routes: the package in a fresh workspace built with catkin_make, catkin build
+#     (catkin-tools) and colcon build, each sourced and used as README says
+#     (scripts/check_workspace.sh);
 #  3. scripts/sanitize.sh: the core gtests under ASan + UBSan (clang, standalone CMake project) and
 #     a short libFuzzer run ($SANITIZE_FUZZ_SECONDS, default 25 s).
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 
-"$root/scripts/setup.sh" --workspace-tools
+"$root/scripts/setup.sh"
 
 echo "== standalone build and tests"
 build_dir=${BUILD_DIR:-$root/build}
@@ -30,10 +31,10 @@ if [[ $results_ok != true || $failed -ne 0 || $passed -eq 0 ]]; then
   exit 1
 fi
 
-echo "== catkin workspace builds"
+echo "== workspace builds: catkin_make, catkin build, colcon build"
 workspaces=$(mktemp -d)
 trap 'rm -rf "$workspaces"' EXIT
-for tool in catkin_make catkin_build; do
+for tool in catkin_make catkin_build colcon; do
   ws=$workspaces/$tool
   mkdir -p "$ws/src"
   ln -s "$root" "$ws/src/projection_collision_avoidance"
@@ -44,10 +45,16 @@ for tool in catkin_make catkin_build; do
       (cd "$ws" && catkin init >/dev/null &&
         catkin config --cmake-args -DPYTHON_EXECUTABLE=/usr/bin/python3 >/dev/null &&
         catkin build --no-status >"$ws/build.log" 2>&1) ;;
+    colcon)
+      (cd "$ws" && colcon build --cmake-args -DPYTHON_EXECUTABLE=/usr/bin/python3 \
+        >"$ws/build.log" 2>&1) ;;
   esac || { tail -40 "$ws/build.log"; echo "test: $tool failed"; exit 1; }
-  test -x "$ws/devel/lib/projection_collision_avoidance/cf_sim" || {
-    echo "test: $tool built no cf_sim"; exit 1; }
-  echo "$tool: built"
+  # README's route from there: source the workspace, then find, run and launch the package.
+  space=$ws/devel
+  [[ $tool == colcon ]] && space=$ws/install
+  "$root/scripts/check_workspace.sh" "$space" >"$ws/check.log" 2>&1 || {
+    cat "$ws/check.log"; echo "test: the $tool workspace does not run"; exit 1; }
+  echo "$tool: built; $(tail -1 "$ws/check.log")"
 done
 
 echo "== sanitizers and fuzzing"
