@@ -7,7 +7,7 @@ Usage::
 
 Reads the follower's status (/follower/status, projection_collision_avoidance/FollowerStatus;
 the only topic of that type if the bag has no /follower/status) and prints one line in the
-format of cf_sim (README.md, 'The summary line')::
+format of cf_sim (doc/cf_sim.md, 'The summary line')::
 
     max_xi=... max_xi_hat=... xi_max=... min_separation=... time_outside=... recorded_s=...
 

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Takes the README's rviz screenshots of formation.launch, as scripts/make_screenshot.sh does for
+# Takes the rviz screenshots of doc/formations.md (formation.launch), as scripts/make_screenshot.sh does for
 # demo.launch: rviz under Xvfb (software OpenGL) on the formation, its window captured with
 # `import` once the plant's simulated time passes the given moment. The master and rviz start
 # first and formation.launch (rviz:=false) only once rviz's window is up; rviz runs a copy of the

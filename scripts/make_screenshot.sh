@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Takes the README's rviz screenshots: demo.launch (the paper's Run 2) under Xvfb, captured at
+# Takes the rviz screenshots of doc/nodes.md: demo.launch (the paper's Run 2) under Xvfb, captured at
 # a simulated time. Without arguments: t ~ 21.5 s, while the leader is pushed back, into
 # doc/rviz_run2.png. Further arguments go to roslaunch, e.g. for the fallback:
 #   scripts/make_screenshot.sh 27 doc/rviz_fallback.png acceleration_limit:=6 \

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Every performance figure of README.md, side by side in one run:
+# Every performance figure of doc/performance_summary.md, side by side in one run:
 #   1. Google Benchmark: one control step in 1-D, 2-D, 3-D (inside the bound and held on it by
 #      the projection), heap allocations and flops per step; whole Run 2 in process;
 #   2. callgrind: instructions per control step (load-independent);
@@ -10,9 +10,9 @@
 #   5. platoon scale: scripts/formation_scale.sh with --with-scale (18 min), else the figures of
 #      its last run in doc/formation_scale.md.
 # Writes the raw figures to doc/performance_data/, then doc/performance.md and the table between
-# the performance markers of README.md; --report-only renders those two from the raw figures.
+# the performance markers of doc/performance_summary.md; --report-only renders those two from the raw figures.
 # Usage: scripts/performance.sh [--reps N] [--ros-runs N] [--ros-duration S] [--skip-ros]
-#                               [--with-scale] [--no-readme] [--report-only]
+#                               [--with-scale] [--no-summary] [--report-only]
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 build_dir=${BUILD_DIR:-$root/build}
@@ -21,7 +21,7 @@ ros_runs=3
 ros_duration=60
 skip_ros=0
 with_scale=0
-update_readme=1
+update_summary=1
 report_only=0
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -30,9 +30,9 @@ while [ $# -gt 0 ]; do
     --ros-duration) ros_duration=$2; shift 2 ;;
     --skip-ros) skip_ros=1; shift ;;
     --with-scale) with_scale=1; shift ;;
-    --no-readme) update_readme=0; shift ;;
+    --no-summary) update_summary=0; shift ;;
     --report-only) report_only=1; shift ;;
-    *) echo "usage: $0 [--reps N] [--ros-runs N] [--ros-duration S] [--skip-ros] [--with-scale] [--no-readme] [--report-only]" >&2
+    *) echo "usage: $0 [--reps N] [--ros-runs N] [--ros-duration S] [--skip-ros] [--with-scale] [--no-summary] [--report-only]" >&2
        exit 2 ;;
   esac
 done
@@ -50,6 +50,7 @@ command -v valgrind >/dev/null || { echo "valgrind is needed for the instruction
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 echo "$reps" >"$data/repetitions"
+date +%F >"$data/date"
 
 echo "== 1/5 Google Benchmark ($reps repetitions)" >&2
 "$bin/benchmark_follower_step" --benchmark_repetitions="$reps" \
@@ -86,12 +87,12 @@ fi
 
 fi
 
-readme_args=()
-if [ "$update_readme" = 1 ]; then
-  readme_args=(--readme "$root/README.md")
+summary_args=()
+if [ "$update_summary" = 1 ]; then
+  summary_args=(--summary "$root/doc/performance_summary.md")
 fi
 /usr/bin/python3 "$root/scripts/performance_report.py" --benchmark "$data/benchmark.json" \
   --instructions "$data/instructions.csv" --solvers "$data/solvers.json" \
   --ros-csv "$root/doc/ros_latency.csv" \
-  --scale "$root/doc/formation_scale.md" --reps "$(cat "$data/repetitions")" --out "$root/doc/performance.md" \
-  "${readme_args[@]}"
+  --scale "$root/doc/formation_scale.md" --reps "$(cat "$data/repetitions")" --date "$(cat "$data/date" 2>/dev/null || date +%F)" --out "$root/doc/performance.md" \
+  "${summary_args[@]}"

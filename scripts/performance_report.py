@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Renders the figures of scripts/performance.sh as doc/performance.md and README's table.
+"""Renders the figures of scripts/performance.sh as doc/performance.md and the table of doc/performance_summary.md.
 
 Inputs (all written by scripts/performance.sh and the scripts it runs):
   --benchmark FILE     Google Benchmark JSON (aggregates of repeated runs)
@@ -7,7 +7,7 @@ Inputs (all written by scripts/performance.sh and the scripts it runs):
   --solvers FILE       JSON of scripts/solver_comparison.py
   --ros-csv FILE       CSV of scripts/ros_latency.sh (optional)
   --scale FILE         doc/formation_scale.md of scripts/formation_scale.sh (optional)
-README.md's table is replaced between the lines <!-- performance:begin --> and
+doc/performance_summary.md's table is replaced between the lines <!-- performance:begin --> and
 <!-- performance:end -->.
 """
 
@@ -103,7 +103,8 @@ def main(argv=None):
     parser.add_argument("--scale")
     parser.add_argument("--reps", type=int, required=True)
     parser.add_argument("--out", required=True)
-    parser.add_argument("--readme")
+    parser.add_argument("--summary")
+    parser.add_argument("--date", help="the day the figures were measured (default: today)")
     args = parser.parse_args(argv)
 
     bench, context = load_benchmarks(args.benchmark)
@@ -112,7 +113,7 @@ def main(argv=None):
     ros = load_ros(args.ros_csv)
     scale = load_scale(args.scale)
     mhz = float(context["mhz_per_cpu"])
-    today = datetime.date.today().isoformat()
+    today = args.date or datetime.date.today().isoformat()
 
     # --- one control step
     step_rows = []
@@ -210,15 +211,15 @@ def main(argv=None):
     with open(args.out, "w") as handle:
         handle.write("\n".join(lines))
 
-    if args.readme:
-        table = readme_table(step_rows, run_sampled, solvers, ros, scale, args.reps, today)
-        text = open(args.readme).read()
+    if args.summary:
+        table = summary_table(step_rows, run_sampled, solvers, ros, scale, args.reps, today)
+        text = open(args.summary).read()
         if BEGIN not in text or END not in text:
-            print(f"{args.readme} has no {BEGIN} ... {END} block", file=sys.stderr)
+            print(f"{args.summary} has no {BEGIN} ... {END} block", file=sys.stderr)
             return 1
         head, rest = text.split(BEGIN, 1)
         _, tail = rest.split(END, 1)
-        with open(args.readme, "w") as handle:
+        with open(args.summary, "w") as handle:
             handle.write(head + BEGIN + "\n" + table + END + tail)
     return 0
 
@@ -300,7 +301,7 @@ def ros_section(ros):
     return lines
 
 
-def readme_table(step_rows, run_sampled, solvers, ros, scale, reps, today):
+def summary_table(step_rows, run_sampled, solvers, ros, scale, reps, today):
     one = step_rows[0]
     three = step_rows[2]
     rows = ["| what | measured | target |", "|---|---|---|"]

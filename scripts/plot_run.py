@@ -19,7 +19,7 @@ Several runs are drawn side by side, with a common y range per row when the
 runs have the same layout, so e.g. Run 1 and Run 2 compare at a glance.
 
 The input is the CSV of ``cf_sim --csv`` / ``reference_sim.py --csv``
-(README.md, section 'Scenario files') or a rosbag recorded by the demo
+(doc/cf_sim.md, section 'Scenario files') or a rosbag recorded by the demo
 (``roslaunch projection_collision_avoidance demo.launch record:=true``; see load_bag()).
 Loading is done by load_run(), which dispatches on the file name to a loader
 returning a dict of column name -> numpy array, the same columns for every loader,
@@ -277,7 +277,7 @@ def load_bag(path):
 
 
 # File-name suffix -> loader. Each loader returns {column: np.ndarray}
-# with the column names of README.md, section 'Scenario files'.
+# with the column names of doc/cf_sim.md, section 'Scenario files'.
 LOADERS = {".csv": load_csv, ".bag": load_bag}
 
 REQUIRED = ("t", "xi_0", "xi_hat_0", "norm_xi", "norm_xi_hat", "xi_max", "xi_soft",

@@ -5,7 +5,7 @@ This is an independent implementation of the closed loop of Gehlot et al.,
 "Projection-Based Inter-Agent Collision Avoidance in Dual Agent Systems", in the
 form fixed by doc/math.md of the shared notes. It exists to cross-check the
 sampled C++ simulator ``cf_sim``: it reads the same scenario YAML
-(README.md, section 'Scenario files'), integrates leader, follower and CF estimator together
+(doc/cf_sim.md, section 'Scenario files'), integrates leader, follower and CF estimator together
 as one ODE with ``scipy.integrate.solve_ivp`` (no sampling, no zero-order hold)
 and prints the same summary line.
 
@@ -71,7 +71,7 @@ PROG = "reference_sim"
 
 
 class ScenarioError(Exception):
-    """A scenario or override that does not follow README.md, section 'Scenario files'."""
+    """A scenario or override that does not follow doc/cf_sim.md, section 'Scenario files'."""
 
 
 # --------------------------------------------------------------------------
@@ -730,7 +730,7 @@ def parse_args(argv):
     ap = argparse.ArgumentParser(
         prog="reference_sim.py",
         description="Continuous-time reference simulation of a scenario (see module docstring).")
-    ap.add_argument("scenario", help="scenario YAML (README.md, section 'Scenario files')")
+    ap.add_argument("scenario", help="scenario YAML (doc/cf_sim.md, section 'Scenario files')")
     ap.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                     help="override a scenario entry by dotted path; VALUE is YAML "
                          "(a numeric path element indexes a list); repeatable")
