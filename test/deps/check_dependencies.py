@@ -59,7 +59,8 @@ DEVELOPMENT_SCRIPTS = {"scripts/test.sh", "scripts/build.sh", "scripts/sanitize.
                        "scripts/setup.sh", "scripts/count_test_results.py",
                        "scripts/performance.sh", "scripts/performance_report.py",
                        "scripts/solver_comparison.py", "scripts/ros_latency.sh",
-                       "scripts/ros_latency.py", "scripts/fault_table.sh"}
+                       "scripts/ros_latency.py", "scripts/fault_table.sh",
+                       "scripts/check_workspace.sh"}
 # Debian packages used by the scripts but not dependencies of the package: catkin's own
 # toolchain, and the workspace tools a user picks. They are in scripts/debian-packages.txt.
 TOOLCHAIN = {"make", "cmake", "catkin", "catkin-tools", "colcon", "python3-colcon-ros",
@@ -153,7 +154,8 @@ def command_uses(words, where, test_only):
             continue
         if word == "rosrun" and len(words) >= 3:
             yield Use("command", "rosrun", where, test_only)
-            yield Use("ROS executable", f"{words[1]}/{words[2]}", where, test_only)
+            if words[1] != PACKAGE and not words[1].startswith("$"):
+                yield Use("ROS executable", f"{words[1]}/{words[2]}", where, test_only)
             return
         if "/" not in word and COMMAND_WORD.match(word):
             yield Use("command", word, where, test_only)
@@ -286,9 +288,27 @@ def priority(package):
 
 @functools.lru_cache(maxsize=None)
 def ros_packages_in(package):
-    """The ROS packages a Debian package installs (its /usr/share/NAME/package.xml files)."""
-    out = subprocess.run(["dpkg-query", "-L", package], capture_output=True, text=True)
-    return sorted(set(re.findall(r"^/usr/share/([^/\n]+)/package\.xml$", out.stdout, re.M)))
+    """The ROS packages a Debian package belongs to: those whose /usr/share/NAME/package.xml it
+    installs, else those of the installed packages built from the same source (Debian ships a
+    ROS package's package.xml in one of them, e.g. rospack's in librospack-dev, not in
+    rospack-tools)."""
+    def shipped(name):
+        out = subprocess.run(["dpkg-query", "-L", name], capture_output=True, text=True)
+        return set(re.findall(r"^/usr/share/([^/\n]+)/package\.xml$", out.stdout, re.M))
+
+    own = shipped(package)
+    if own:
+        return sorted(own)
+    out = subprocess.run(["dpkg-query", "-W", "-f=${Package}\t${Source}\t${Status}\n"],
+                         capture_output=True, text=True)
+    sources = {}
+    for line in out.stdout.split("\n"):
+        fields = line.split("\t")
+        if len(fields) == 3 and fields[2].endswith(" installed"):
+            sources[fields[0]] = fields[1].split(" ")[0] or fields[0]
+    source = sources.get(package, package)
+    siblings = [name for name, src in sources.items() if src == source and name != package]
+    return sorted(set().union(*(shipped(name) for name in siblings))) if siblings else []
 
 
 @functools.lru_cache(maxsize=None)
