@@ -32,28 +32,27 @@ from __future__ import annotations
 
 import argparse
 import ast
-import functools
-import importlib.util
 import os
 import re
-import shutil
 import subprocess
 import sys
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
 
+from debian_lookup import (debian_package, priority, providing_file, reverse_dependencies,
+                           ros_packages_in)
 from shell_commands import simple_commands
 
 PACKAGE = "projection_collision_avoidance"
 SKIPPED_DIRS = {".git", "build", "build-sanitize", "devel", "install", "log", "out", "__pycache__"}
 SUBPROCESS_CALLS = {"run", "Popen", "call", "check_call", "check_output"}
-# Shell words that start a command but are not programs.
-SHELL_WORDS = {"if", "then", "else", "elif", "fi", "for", "in", "do", "done", "while", "until",
-               "case", "esac", "function", "time", "!", "{", "}", "[[", "]]", "select"}
-# Words that run the rest of the line as a command (their own arguments skipped as given).
-WRAPPERS = {"exec": 0, "sudo": 0, "nohup": 0, "env": 0, "command": 0, "timeout": 1,
-            "chrt": 2, "taskset": 1, "nice": 0}
+# Programs that run the rest of their arguments as a command: (positional arguments before the
+# command, options that take a value).
+WRAPPERS = {"exec": (0, set()), "sudo": (0, {"-u", "-g"}), "nohup": (0, set()),
+            "env": (0, {"-u"}), "command": (0, set()), "nice": (0, {"-n"}),
+            "timeout": (1, {"-s", "--signal", "-k", "--kill-after"}), "chrt": (1, set()),
+            "taskset": (1, set())}
 # Scripts that build, test and measure the package: what only they use may be a test_depend.
 DEVELOPMENT_SCRIPTS = {"scripts/test.sh", "scripts/build.sh", "scripts/sanitize.sh",
                        "scripts/setup.sh", "scripts/count_test_results.py",
@@ -65,8 +64,6 @@ DEVELOPMENT_SCRIPTS = {"scripts/test.sh", "scripts/build.sh", "scripts/sanitize.
 # toolchain, and the workspace tools a user picks. They are in scripts/debian-packages.txt.
 TOOLCHAIN = {"make", "cmake", "catkin", "catkin-tools", "colcon", "python3-colcon-ros",
              "python3-colcon-bash", "git"}
-# Where Debian installs programs (a PATH lookup, without /usr/local and the like).
-SYSTEM_PATH = "/usr/sbin:/usr/bin:/sbin:/bin"
 COMMAND_WORD = re.compile(r"^[A-Za-z][A-Za-z0-9_.+-]*$")
 
 
@@ -147,10 +144,11 @@ def command_uses(words, where, test_only):
         word = words[0]
         if word in WRAPPERS and len(words) > 1:
             yield Use("command", word, where, test_only)
-            skip = 1 + WRAPPERS[word]
-            while skip < len(words) and words[skip].startswith("-"):
-                skip += 1
-            words = words[skip:]
+            positional, valued = WRAPPERS[word]
+            rest = words[1:]
+            while rest and (rest[0].startswith("-") or re.match(r"^\w+=", rest[0])):
+                rest = rest[2:] if rest[0] in valued else rest[1:]
+            words = rest[positional:]
             continue
         if word == "rosrun" and len(words) >= 3:
             yield Use("command", "rosrun", where, test_only)
@@ -176,8 +174,7 @@ def shell_uses(root, path, builtins, functions):
     text = path.read_text()
     test_only = is_test_path(root, path)
     for line, words in simple_commands(text):
-        while words and (re.match(r"^[A-Za-z_][A-Za-z0-9_]*(\[.*\])?\+?=", words[0])
-                         or words[0] in SHELL_WORDS):
+        while words and re.match(r"^[A-Za-z_][A-Za-z0-9_]*(\[.*\])?\+?=", words[0]):
             words = words[1:]
         if not words or words[0] in builtins or words[0] in functions or words[0] in ("[[", "["):
             continue
@@ -234,96 +231,6 @@ def all_uses(root):
     for path in source_files(root, {".launch", ".test"}):
         yield from launch_uses(root, path)
     yield from message_uses(root)
-
-
-# ----------------------------------------------------------------------------------------------
-# Resolving on this machine
-
-
-@functools.lru_cache(maxsize=None)
-def providing_file(kind, name):
-    """The installed file behind a use, or None."""
-    if kind == "python module":
-        try:
-            spec = importlib.util.find_spec(name)
-        except (ImportError, ValueError):
-            spec = None
-        if spec is None:
-            return None
-        if spec.origin and spec.origin not in ("built-in", "frozen", "namespace"):
-            return spec.origin
-        locations = list(spec.submodule_search_locations or [])
-        return locations[0] if locations else None
-    if kind == "command":
-        path = shutil.which(name, path=SYSTEM_PATH)
-        return os.path.realpath(path) if path else None
-    if kind == "ROS executable":
-        pkg, executable = name.split("/", 1)
-        for directory in (f"/usr/lib/{pkg}", f"/usr/share/{pkg}/scripts", "/usr/bin"):
-            candidate = Path(directory) / executable
-            if candidate.exists():
-                return str(candidate)
-        return None
-    raise ValueError(kind)
-
-
-@functools.lru_cache(maxsize=None)
-def debian_package(path):
-    out = subprocess.run(["dpkg-query", "-S", path], capture_output=True, text=True)
-    if out.returncode != 0:
-        # dpkg knows the unresolved path (e.g. /bin/x when /bin -> usr/bin).
-        alternative = re.sub(r"^/usr/", "/", path)
-        out = subprocess.run(["dpkg-query", "-S", alternative], capture_output=True, text=True)
-        if out.returncode != 0:
-            return None
-    return out.stdout.split(":")[0].split(",")[0].strip()
-
-
-@functools.lru_cache(maxsize=None)
-def priority(package):
-    out = subprocess.run(["dpkg-query", "-W", "-f=${Priority}", package], capture_output=True,
-                         text=True)
-    return out.stdout.strip()
-
-
-@functools.lru_cache(maxsize=None)
-def ros_packages_in(package):
-    """The ROS packages a Debian package belongs to: those whose /usr/share/NAME/package.xml it
-    installs, else those of the installed packages built from the same source (Debian ships a
-    ROS package's package.xml in one of them, e.g. rospack's in librospack-dev, not in
-    rospack-tools)."""
-    def shipped(name):
-        out = subprocess.run(["dpkg-query", "-L", name], capture_output=True, text=True)
-        return set(re.findall(r"^/usr/share/([^/\n]+)/package\.xml$", out.stdout, re.M))
-
-    own = shipped(package)
-    if own:
-        return sorted(own)
-    out = subprocess.run(["dpkg-query", "-W", "-f=${Package}\t${Source}\t${Status}\n"],
-                         capture_output=True, text=True)
-    sources = {}
-    for line in out.stdout.split("\n"):
-        fields = line.split("\t")
-        if len(fields) == 3 and fields[2].endswith(" installed"):
-            sources[fields[0]] = fields[1].split(" ")[0] or fields[0]
-    source = sources.get(package, package)
-    siblings = [name for name, src in sources.items() if src == source and name != package]
-    return sorted(set().union(*(shipped(name) for name in siblings))) if siblings else []
-
-
-@functools.lru_cache(maxsize=None)
-def reverse_dependencies(package):
-    """The installed packages that depend on `package` directly (e.g. imagemagick on
-    imagemagick-6.q16, which provides its programs)."""
-    out = subprocess.run(["dpkg-query", "-W", "-f=${Package}\t${Depends}\n"],
-                         capture_output=True, text=True)
-    users = set()
-    for line in out.stdout.split("\n"):
-        name, _, depends = line.partition("\t")
-        alternatives = re.split(r"[,|]", depends)
-        if any(a.split("(")[0].split(":")[0].strip() == package for a in alternatives):
-            users.add(name)
-    return frozenset(users)
 
 
 def listed_packages(root):

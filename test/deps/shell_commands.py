@@ -1,8 +1,10 @@
 """The simple commands of a bash script: enough of bash's grammar to find the programs it runs.
 
-``simple_commands(text)`` yields ``(line, words)`` for each simple command, with quotes removed,
-including the commands inside ``$(...)``, backticks and ``"...$(...)..."``. Comments, here-document
-bodies, ``case`` patterns and arithmetic ``((...))`` are skipped.
+``simple_commands(text)`` yields ``(line, words)`` for each simple command, with quotes and
+leading reserved words (``then``, ``do``, ``!``, ...) removed,
+including the commands inside ``$(...)``, backticks and ``"...$(...)..."``. Comments,
+here-document bodies, ``case`` patterns, ``for`` word lists and arithmetic ``((...))`` are
+skipped.
 """
 
 from __future__ import annotations
@@ -10,6 +12,9 @@ from __future__ import annotations
 import re
 
 HEREDOC = re.compile(r"(?<!<)<<(?!<)-?\s*(['\"]?)([A-Za-z_][A-Za-z0-9_]*)\1")
+# Reserved words that may come before a command ("then make", "do ls", "! grep").
+RESERVED = {"if", "then", "else", "elif", "fi", "do", "done", "while", "until", "esac", "time",
+            "!", "{", "}"}
 OPERATORS = ("&&", "||", ";;", ";", "|", "&", "\n")
 
 
@@ -44,6 +49,8 @@ class _Lexer:
             nonlocal words, word, start, cases, pattern
             if word is not None:
                 words.append(word)
+            while words and words[0] in RESERVED:
+                words = words[1:]
             if words[:1] == ["case"] and words[-1] == "in":
                 cases += 1
                 pattern = True
@@ -112,7 +119,7 @@ class _Lexer:
                 finish()
                 self.advance(len(op))
                 start = self.line
-                pattern = op == ";;" and cases > 0
+                pattern = pattern or (op == ";;" and cases > 0)
             elif c in " \t":
                 if word is not None:
                     words.append(word)
