@@ -2,7 +2,10 @@
 /// and its dynamic_reconfigure interface, on the paper's Run 2. Parameters of the test node:
 ///   ~wall_deadline  wall seconds to wait for each condition
 
+#include <cmath>
+#include <limits>
 #include <set>
+#include <string>
 
 #include <dynamic_reconfigure/Reconfigure.h>
 #include <gtest/gtest.h>
@@ -145,6 +148,46 @@ TEST_F(FollowerTest, ReconfigureSwitchesTheTrackerAndRefusesAnInvalidAlpha) {
   const dynamic_reconfigure::Config accepted = reconfigure("alpha", 0.3, false, false);
   EXPECT_DOUBLE_EQ(doubleOf(accepted, "alpha"), 0.3);
   EXPECT_TRUE(waitFor([this] { return std::abs(record_.last.xi_max - 3.5) < 1e-12; }, deadline));
+}
+
+/// The tracker gain the follower's diagnostics report, "" before they do.
+std::string trackerGainOf(const diagnostic_msgs::DiagnosticStatus& status) {
+  for (const auto& value : status.values) {
+    if (value.key == "tracker_gain") {
+      return value.value;
+    }
+  }
+  return "";
+}
+
+TEST_F(FollowerTest, ReconfigureFrequencyZeroRestoresTheFilesGainAndNeverStoresNonFinite) {
+  const double deadline = param("wall_deadline");
+  const auto gain_is = [this](const std::string& gain) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    return !follower_diagnostics_.empty() && trackerGainOf(follower_diagnostics_.back()) == gain;
+  };
+  // Run 2's G_e = [10, 5]; (omega_n, zeta) = (2, 0.7) gives [omega_n^2, 2 zeta omega_n].
+  ASSERT_TRUE(waitFor([&] { return gain_is("[10, 5]"); }, deadline));
+  reconfigure("tracker_damping", 0.7, false, false);
+  const dynamic_reconfigure::Config set = reconfigure("tracker_natural_frequency", 2.0, false, false);
+  EXPECT_DOUBLE_EQ(doubleOf(set, "tracker_natural_frequency"), 2.0);
+  EXPECT_TRUE(waitFor([&] { return gain_is("[4, 2.8]"); }, deadline));
+  const dynamic_reconfigure::Config restored =
+      reconfigure("tracker_natural_frequency", 0.0, false, false);
+  EXPECT_DOUBLE_EQ(doubleOf(restored, "tracker_natural_frequency"), 0.0);
+  EXPECT_TRUE(waitFor([&] { return gain_is("[10, 5]"); }, deadline));
+
+  // Non-finite values are refused, whether or not they would be used, and never stored.
+  for (const char* name : {"alpha", "epsilon", "tracker_damping", "tracker_natural_frequency"}) {
+    // The configuration in force, from a call that changes nothing.
+    const double before = doubleOf(reconfigure("tracker_damping", 0.7, false, false), name);
+    for (const double bad : {std::nan(""), std::numeric_limits<double>::infinity()}) {
+      const dynamic_reconfigure::Config answer = reconfigure(name, bad, false, false);
+      EXPECT_TRUE(std::isfinite(doubleOf(answer, name))) << name;
+      EXPECT_DOUBLE_EQ(doubleOf(answer, name), before) << name;
+    }
+  }
+  EXPECT_TRUE(waitFor([&] { return gain_is("[10, 5]"); }, deadline));
 }
 
 }  // namespace
