@@ -1,10 +1,13 @@
 #include "projection_collision_avoidance/ScenarioLoader.hpp"
 
+#include <array>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <exception>
 #include <filesystem>
 #include <fstream>
+#include <ios>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -285,7 +288,8 @@ SignalProfile readInputProfile(detail::YamlReader& leader, Eigen::Index size) {
   return profile;
 }
 
-Scenario readScenario(const YAML::Node& root) {
+/// Reads every key, runs the per-key checks, then @p check, then the design's derived checks.
+Scenario readScenario(const YAML::Node& root, const ScenarioLoadOptions& options) {
   detail::YamlReader reader(root, "");
   Scenario scenario;
   const AgentModel model = readModel(reader);
@@ -326,12 +330,16 @@ Scenario readScenario(const YAML::Node& root) {
   }
   reader.finish();
 
-  ControllerDesign::create(scenario.controller);
   scenario.validate();
+  if (options.check) {
+    options.check(scenario);
+  }
+  ControllerDesign::create(scenario.controller);
   return scenario;
 }
 
-Scenario parseRoot(YAML::Node root, const std::vector<std::string>& overrides) {
+Scenario parseRoot(YAML::Node root, const std::vector<std::string>& overrides,
+                   const ScenarioLoadOptions& options) {
   if (!root.IsMap()) {
     throw ParameterError("(root)", "a scenario is a YAML map");
   }
@@ -339,34 +347,68 @@ Scenario parseRoot(YAML::Node root, const std::vector<std::string>& overrides) {
     for (const std::string& assignment : overrides) {
       applyOverride(root, assignment);
     }
-    return readScenario(root);
+    return readScenario(root, options);
   } catch (const YAML::Exception& error) {  // every read names its key; this is a safety net
     throw ParameterError("(root)", std::string("cannot be read: ") + error.what());
   }
 }
 
-}  // namespace
+/// Bytes read from a scenario file at a time.
+constexpr std::size_t kReadChunkBytes = 16384;
 
-Scenario scenarioFromYaml(const YAML::Node& root, const std::vector<std::string>& overrides) {
-  return parseRoot(YAML::Clone(root), overrides);
+std::string tooLarge(const std::string& path, const std::string& size) {
+  return "'" + path + "' has " + size + " bytes, over the size limit of a scenario (" +
+         std::to_string(kMaxScenarioBytes) + " bytes)";
 }
 
-Scenario parseScenario(const std::string& yaml_text, const std::vector<std::string>& overrides) {
-  return parseRoot(detail::parseYaml(yaml_text), overrides);
-}
-
-Scenario loadScenarioFile(const std::string& path, const std::vector<std::string>& overrides) {
-  std::error_code ignored;
-  if (std::filesystem::is_directory(path, ignored)) {
+/// The text of a scenario file, refused over kMaxScenarioBytes: a regular file by its size
+/// before it is read, any other (a pipe, a device) once one byte more has been read.
+std::string readScenarioText(const std::string& path) {
+  std::error_code error;
+  if (std::filesystem::is_directory(path, error)) {
     throw ParameterError("(file)", "'" + path + "' is a directory, not a scenario file");
   }
-  std::ifstream file(path);
+  const std::uintmax_t size = std::filesystem::file_size(path, error);
+  if (!error && size > kMaxScenarioBytes) {
+    throw ParameterError("(file)", tooLarge(path, std::to_string(size)));
+  }
+  std::ifstream file(path, std::ios::binary);
   if (!file) {
     throw ParameterError("(file)", "cannot read '" + path + "'");
   }
-  std::stringstream text;
-  text << file.rdbuf();
-  return parseScenario(text.str(), overrides);
+  std::string text;
+  if (!error) {
+    text.reserve(static_cast<std::size_t>(size));
+  }
+  std::array<char, kReadChunkBytes> chunk{};
+  while (file.read(chunk.data(), chunk.size()) || file.gcount() > 0) {
+    text.append(chunk.data(), static_cast<std::size_t>(file.gcount()));
+    if (text.size() > kMaxScenarioBytes) {
+      throw ParameterError("(file)",
+                           tooLarge(path, "more than " + std::to_string(kMaxScenarioBytes)));
+    }
+  }
+  if (file.bad()) {
+    throw ParameterError("(file)", "cannot read '" + path + "'");
+  }
+  return text;
+}
+
+}  // namespace
+
+Scenario scenarioFromYaml(const YAML::Node& root, const std::vector<std::string>& overrides,
+                          const ScenarioLoadOptions& options) {
+  return parseRoot(YAML::Clone(root), overrides, options);
+}
+
+Scenario parseScenario(const std::string& yaml_text, const std::vector<std::string>& overrides,
+                       const ScenarioLoadOptions& options) {
+  return parseRoot(detail::parseYaml(yaml_text, options.cancelled), overrides, options);
+}
+
+Scenario loadScenarioFile(const std::string& path, const std::vector<std::string>& overrides,
+                          const ScenarioLoadOptions& options) {
+  return parseScenario(readScenarioText(path), overrides, options);
 }
 
 }  // namespace projection_collision_avoidance
