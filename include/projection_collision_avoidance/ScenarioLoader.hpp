@@ -16,14 +16,16 @@
 
 namespace projection_collision_avoidance {
 
-/// Limits on a scenario's YAML, checked while it is read (doc/cf_sim.md, "Limits"). The largest
-/// scenario of config/scenarios has under 2 KB, about 100 nodes, and lists nested 5 deep.
+// Limits on a scenario's YAML, checked while it is read (doc/cf_sim.md, "Limits"). The largest
+// scenario of config/scenarios has under 2 KB, about 100 nodes, and lists and maps nested 6
+// deep; a formation of any size is one number (formation.followers).
+
 /// Bytes of a scenario file (or text): 1 MiB.
 constexpr std::size_t kMaxScenarioBytes = std::size_t{1} << 20U;
 /// Lists and maps nested in one another, the root counting as 1.
 constexpr std::size_t kMaxScenarioDepth = 64;
 /// Nodes of the tree (scalars, lists, maps, keys included), an alias counting as every node it
-/// repeats. About 50 MB of yaml-cpp tree at most.
+/// repeats: at most about 55 MB of yaml-cpp tree.
 constexpr std::size_t kMaxScenarioNodes = 100000;
 
 /// A load ended by its cancellation predicate (ScenarioLoadOptions::cancelled).
