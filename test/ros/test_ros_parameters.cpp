@@ -35,7 +35,7 @@ ParameterError nodeRefusal(const std::vector<std::string>& overrides) {
     return error;
   }
   ADD_FAILURE() << "accepted";
-  return ParameterError("", "");
+  return {"", ""};
 }
 
 TEST(NodeScenario, NamesTheControlRateTheUserWrote) {
@@ -96,6 +96,7 @@ TEST(ToYaml, RefusesNestingOverTheDepthLimit) {
 TEST(ToYaml, RefusesTreesOverTheNodeLimit) {
   XmlRpc::XmlRpcValue list;
   list.setSize(static_cast<int>(kMaxScenarioNodes - 1));
+  // NOLINTNEXTLINE(modernize-loop-convert): XmlRpcValue's iterators walk a struct, not an array
   for (int i = 0; i < list.size(); ++i) {
     list[i] = 1;
   }
