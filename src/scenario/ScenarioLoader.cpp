@@ -1,13 +1,8 @@
 #include "projection_collision_avoidance/ScenarioLoader.hpp"
 
-#include <array>
 #include <cmath>
 #include <cstddef>
-#include <cstdint>
 #include <exception>
-#include <filesystem>
-#include <fstream>
-#include <ios>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -353,47 +348,6 @@ Scenario parseRoot(YAML::Node root, const std::vector<std::string>& overrides,
   }
 }
 
-/// Bytes read from a scenario file at a time.
-constexpr std::size_t kReadChunkBytes = 16384;
-
-std::string tooLarge(const std::string& path, const std::string& size) {
-  return "'" + path + "' has " + size + " bytes, over the size limit of a scenario (" +
-         std::to_string(kMaxScenarioBytes) + " bytes)";
-}
-
-/// The text of a scenario file, refused over kMaxScenarioBytes: a regular file by its size
-/// before it is read, any other (a pipe, a device) once one byte more has been read.
-std::string readScenarioText(const std::string& path) {
-  std::error_code error;
-  if (std::filesystem::is_directory(path, error)) {
-    throw ParameterError("(file)", "'" + path + "' is a directory, not a scenario file");
-  }
-  const std::uintmax_t size = std::filesystem::file_size(path, error);
-  if (!error && size > kMaxScenarioBytes) {
-    throw ParameterError("(file)", tooLarge(path, std::to_string(size)));
-  }
-  std::ifstream file(path, std::ios::binary);
-  if (!file) {
-    throw ParameterError("(file)", "cannot read '" + path + "'");
-  }
-  std::string text;
-  if (!error) {
-    text.reserve(static_cast<std::size_t>(size));
-  }
-  std::array<char, kReadChunkBytes> chunk{};
-  while (file.read(chunk.data(), chunk.size()) || file.gcount() > 0) {
-    text.append(chunk.data(), static_cast<std::size_t>(file.gcount()));
-    if (text.size() > kMaxScenarioBytes) {
-      throw ParameterError("(file)",
-                           tooLarge(path, "more than " + std::to_string(kMaxScenarioBytes)));
-    }
-  }
-  if (file.bad()) {
-    throw ParameterError("(file)", "cannot read '" + path + "'");
-  }
-  return text;
-}
-
 }  // namespace
 
 Scenario scenarioFromYaml(const YAML::Node& root, const std::vector<std::string>& overrides,
@@ -408,7 +362,7 @@ Scenario parseScenario(const std::string& yaml_text, const std::vector<std::stri
 
 Scenario loadScenarioFile(const std::string& path, const std::vector<std::string>& overrides,
                           const ScenarioLoadOptions& options) {
-  return parseScenario(readScenarioText(path), overrides, options);
+  return parseScenario(detail::readYamlFile(path), overrides, options);
 }
 
 }  // namespace projection_collision_avoidance

@@ -1,9 +1,15 @@
 #include "YamlParser.hpp"
 
+#include <array>
 #include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <ios>
 #include <map>
 #include <set>
 #include <string>
+#include <system_error>
 #include <utility>
 #include <vector>
 
@@ -17,6 +23,14 @@ namespace {
 
 /// Path elements shown in a message; a deeper path ends in "...".
 constexpr std::size_t kPathElementsShown = 8;
+
+/// Bytes read from a scenario file at a time.
+constexpr std::size_t kReadChunkBytes = 16384;
+
+std::string tooLarge(const std::string& path, const std::string& size) {
+  return "'" + path + "' has " + size + " bytes, over the size limit of a scenario (" +
+         std::to_string(kMaxScenarioBytes) + " bytes)";
+}
 
 std::string at(const yaml_mark_t& mark) {
   return "line " + std::to_string(mark.line + 1) + ", column " + std::to_string(mark.column + 1);
@@ -299,6 +313,37 @@ YAML::Node parseYaml(const std::string& yaml_text, const std::function<bool()>& 
     }
   }
   return builder.root();
+}
+
+std::string readYamlFile(const std::string& path) {
+  std::error_code error;
+  if (std::filesystem::is_directory(path, error)) {
+    throw ParameterError("(file)", "'" + path + "' is a directory, not a scenario file");
+  }
+  const std::uintmax_t size = std::filesystem::file_size(path, error);
+  if (!error && size > kMaxScenarioBytes) {
+    throw ParameterError("(file)", tooLarge(path, std::to_string(size)));
+  }
+  std::ifstream file(path, std::ios::binary);
+  if (!file) {
+    throw ParameterError("(file)", "cannot read '" + path + "'");
+  }
+  std::string text;
+  if (!error) {
+    text.reserve(static_cast<std::size_t>(size));
+  }
+  std::array<char, kReadChunkBytes> chunk{};
+  while (file.read(chunk.data(), static_cast<std::streamsize>(chunk.size())) || file.gcount() > 0) {
+    text.append(chunk.data(), static_cast<std::size_t>(file.gcount()));
+    if (text.size() > kMaxScenarioBytes) {
+      throw ParameterError("(file)",
+                           tooLarge(path, "more than " + std::to_string(kMaxScenarioBytes)));
+    }
+  }
+  if (file.bad()) {
+    throw ParameterError("(file)", "cannot read '" + path + "'");
+  }
+  return text;
 }
 
 }  // namespace projection_collision_avoidance::detail

@@ -9,7 +9,8 @@
 /// "NULL" a null node, aliases sharing their anchor's node.
 ///
 /// The limits of ScenarioLoader.hpp (kMaxScenarioBytes, kMaxScenarioDepth, kMaxScenarioNodes)
-/// are checked while the events arrive, so that a refused text costs no more than the limits.
+/// are checked while the file is read and the events arrive, so that a refused text costs no
+/// more than the limits.
 
 #include <cstddef>
 #include <functional>
@@ -30,5 +31,11 @@ constexpr std::size_t kCancelPollEvents = 256;
 ///         appears twice in one map, or text beyond a limit (naming the limit and where)
 /// @throws ScenarioLoadCancelled when @p cancelled returned true
 YAML::Node parseYaml(const std::string& text, const std::function<bool()>& cancelled = {});
+
+/// The text of the file at @p path, at most kMaxScenarioBytes: a regular file is refused by its
+/// size before it is read, any other (a pipe, a device) once one byte more has been read.
+/// @throws ParameterError with key "(file)" for a directory, a file that cannot be read, or one
+///         over the size limit (naming the path, its size and the limit)
+std::string readYamlFile(const std::string& path);
 
 }  // namespace projection_collision_avoidance::detail
