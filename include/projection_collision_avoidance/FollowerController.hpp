@@ -21,7 +21,7 @@ struct FollowerControllerStatus {
   typename Dims::StateVector estimate;             ///< xi_hat used at this tick (m)
   double estimate_norm = 0.0;                      ///< ||xi_hat|| (m), euclideanNorm()
   double constraint_value = 0.0;                   ///< f(xi_hat) (13)
-  bool command_saturated = false;    ///< the sum exceeded acceleration_limit and was scaled
+  bool command_saturated = false;  ///< the sum exceeded acceleration_limit and was scaled
   /// The saturated command was more than jerk_limit T from the previous one and was moved to
   /// that distance from it.
   bool command_rate_limited = false;
@@ -79,7 +79,8 @@ class FollowerController {
         output_pseudoinverse_(design.output_pseudoinverse),
         fallback_gain_(design.fallback_gain),
         rate_limiter_(design.parameters.jerk_limit, design.period,
-                      design.parameters.acceleration_limit, design.parameters.model.inputDimension()) {
+                      design.parameters.acceleration_limit,
+                      design.parameters.model.inputDimension()) {
     status_.command = InputVector::Zero(design.parameters.model.inputDimension());
     status_.baseline_command = status_.command;
     status_.tracker_command = status_.command;
