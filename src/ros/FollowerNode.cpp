@@ -453,6 +453,8 @@ void FollowerNode::publishStatus(const ros::Time& now, const Eigen::VectorXd& xi
   msg.projection_active = s.projection_active;
   msg.command_saturated = s.command_saturated;
   msg.acceleration_limit = parameters_.acceleration_limit;
+  msg.command_rate_limited = s.command_rate_limited;
+  msg.jerk_limit = parameters_.jerk_limit;
   msg.tracker_enabled = parameters_.tracker_enabled;
   msg.command = toStdVector(s.command);
   msg.baseline_command = toStdVector(s.baseline_command);
@@ -557,6 +559,8 @@ void FollowerNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
   status.add("projection_active", s.projection_active);
   status.add("command_saturated", s.command_saturated);
   status.add("acceleration_limit (m/s^2)", parameters_.acceleration_limit);
+  status.add("command_rate_limited", s.command_rate_limited);
+  status.add("jerk_limit (m/s^3)", parameters_.jerk_limit);
   status.add("tracker_enabled", parameters_.tracker_enabled);
   std::ostringstream gain;  // G_e in force, row by row
   gain << parameters_.tracker_gain.format(

@@ -189,6 +189,9 @@ ControllerParameters readController(detail::YamlReader& reader, const AgentModel
   if (controller.has("acceleration_limit")) {
     result.acceleration_limit = controller.number("acceleration_limit");
   }
+  if (controller.has("jerk_limit")) {
+    result.jerk_limit = controller.number("jerk_limit");
+  }
   if (controller.has("fallback")) {
     detail::YamlReader fallback = controller.map("fallback");
     if (fallback.has("gain") && fallback.has("velocity_gain")) {

@@ -72,6 +72,8 @@ TEST_F(FollowerTest, PublishesStatusWithTheScenariosBounds) {
               1e-12);
   EXPECT_TRUE(s.tracker_enabled);
   EXPECT_FALSE(s.command_saturated);
+  EXPECT_FALSE(s.command_rate_limited);
+  EXPECT_TRUE(std::isinf(s.jerk_limit));
   EXPECT_NEAR(s.separation, 5.0, 0.05);  // before the disturbance the follower holds its slot
 }
 
