@@ -8,9 +8,8 @@ for each whether it must be accepted or refused, given the receiver's clock. Sta
 are avoided by a margin, so that the verdict does not hang on the transport's delay."""
 
 import math
-import random
 
-import genpy
+import rospy
 
 LATEST = (4294967295, 999999999)  # the largest ros::Time
 MARGIN = 0.3  # s kept between a generated stamp and any limit
@@ -19,7 +18,7 @@ MARGIN = 0.3  # s kept between a generated stamp and any limit
 def to_time(seconds):
     seconds = min(max(seconds, 0.0), 4294967295.0)
     secs = int(seconds)
-    return genpy.Time(secs, min(999999999, int(round((seconds - secs) * 1e9))))
+    return rospy.Time(secs, min(999999999, int(round((seconds - secs) * 1e9))))
 
 
 def stamp_seconds(stamp):
@@ -68,18 +67,18 @@ class Generator:
         return self.good_stamp(now), self.frame, vectors, True
 
     def zero_stamp(self, now):
-        return genpy.Time(0, 0), self.frame, self.good_values(self.rng), False
+        return rospy.Time(0, 0), self.frame, self.good_values(self.rng), False
 
     def future_stamp(self, now):
         low = now + self.max_future + MARGIN
         stamp = self.rng.choice((to_time(self.rng.uniform(low, low + 10.0)),
                                  to_time(self.rng.uniform(low, 4294967295.0)),
-                                 genpy.Time(*LATEST)))
+                                 rospy.Time(*LATEST)))
         return stamp, self.frame, self.good_values(self.rng), False
 
     def stale_stamp(self, now):
         high = now - self.max_age - MARGIN
-        stamp = self.rng.choice((genpy.Time(0, 1), genpy.Time(1, 0),
+        stamp = self.rng.choice((rospy.Time(0, 1), rospy.Time(1, 0),
                                  to_time(self.rng.uniform(1.0, high))))
         return stamp, self.frame, self.good_values(self.rng), False
 

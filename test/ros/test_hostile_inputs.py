@@ -221,10 +221,10 @@ class HostileInputs(unittest.TestCase):
         outputs = self.record.plant_outputs
         for _ in range(rospy.get_param("~messages")):
             now = self.clock_now()
-            stamp = self.rng.choice((genpy_time(0), hostile.to_time(now),
+            stamp = self.rng.choice((ros_time(0), hostile.to_time(now),
                                      hostile.to_time(now - 0.01), hostile.to_time(now + 5),
                                      hostile.to_time(self.rng.uniform(0, 4294967295)),
-                                     genpy_time(*hostile.LATEST)))
+                                     ros_time(*hostile.LATEST)))
             frame = self.rng.choice(("leader", "follower", "world", "", "x" * 100000))
             values = hostile.any_values(self.rng, {"a": 3, "b": 3})
             command = AccelStamped()
@@ -267,8 +267,8 @@ class HostileInputs(unittest.TestCase):
         self.assert_alive_and_sane()
 
 
-def genpy_time(secs, nsecs=0):
-    return hostile.genpy.Time(secs, nsecs)
+def ros_time(secs, nsecs=0):
+    return rospy.Time(secs, nsecs)
 
 
 if __name__ == "__main__":

@@ -8,7 +8,8 @@ timeout, and tracks again after every jump.
 
 ~case "stall": the follower of pair.launch (Run 2, tracker on) is stopped with SIGSTOP for
 ~stall_s seconds and continued. After it resumes it publishes no fallback step (the measurements
-were flowing all along), counts the stalled periods as missed, and keeps tracking.
+were flowing all along), counts the stalled periods as missed, keeps tracking, and no two
+consecutive commands differ by more than ~jerk_limit / ~control_rate (controller.jerk_limit).
 
 Parameters: ~wall_deadline (s) for each awaited condition, ~measurement_timeout (s)."""
 
@@ -23,7 +24,6 @@ import time
 import unittest
 import xmlrpc.client
 
-import genpy
 import rosbag
 import rosnode
 import rospy
@@ -73,7 +73,7 @@ class TimeFaults(unittest.TestCase):
             path = os.path.join(work, "measurements.bag")
             with rosbag.Bag(path, "w") as bag:
                 for k in range(301):
-                    stamp = genpy.Time.from_sec(start + 0.01 * k)
+                    stamp = rospy.Time.from_sec(start + 0.01 * k)
                     msg = RelativeMeasurement()
                     msg.header.stamp, msg.header.frame_id = stamp, "world"
                     msg.position, msg.velocity = [5.0], [0.0]
@@ -124,6 +124,13 @@ class TimeFaults(unittest.TestCase):
         self.assertGreaterEqual(after[-1].missed_periods - before.missed_periods,
                                 0.5 * stalled_periods)
         self.assertEqual(after[-1].mode, FollowerStatus.MODE_TRACKING)
+        # Consecutive commands, the one before the stall included, differ by at most J T.
+        max_change = rospy.get_param("~jerk_limit") / rospy.get_param("~control_rate")
+        steps = [before] + after
+        for previous, status in zip(steps, steps[1:]):
+            change = math.sqrt(sum((a - b) ** 2 for a, b in zip(status.command, previous.command)))
+            self.assertLessEqual(change, max_change + 1e-9,
+                                 f"command jumps by {change} m/s^2 at tick {status.ticks}")
         self.assertLess(time.monotonic() - resumed, self.deadline)
 
 
