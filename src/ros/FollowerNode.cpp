@@ -353,16 +353,27 @@ void FollowerNode::onLoopTick(const PeriodicTick& tick) {
 }
 
 void FollowerNode::controlTick(const ros::Time& now, double delay, std::uint32_t skipped) {
-  if (delay > 0.5 * options_.measurement_timeout) {
+  const double grace = 0.5 * options_.measurement_timeout;
+  if (delay > grace) {
     // The tick itself ran late by a good part of the timeout: the process was stalled, and the
     // measurements sent meanwhile are not read yet. Judging their age now would brake for
-    // nothing; the next tick decides on what arrived.
-    addSaturated(&missed_periods_, skipped + 1);
+    // nothing: wait for them (at most `grace` s) before deciding.
+    resuming_ = true;
+    resumed_at_ = now;
+    accepted_at_stall_ = measurement_guard_.accepted();
     ROS_WARN_STREAM_THROTTLE(5.0, private_nh_.getNamespace()
                                       << ": control tick " << delay
-                                      << " s late (the process was stalled): skipped");
-    diagnostics_.update();
-    return;
+                                      << " s late (the process was stalled): waiting up to "
+                                      << grace << " s for the input sent meanwhile");
+  }
+  if (resuming_) {
+    if (measurement_guard_.accepted() == accepted_at_stall_ &&
+        secondsBetween(now, resumed_at_) < grace) {
+      addSaturated(&missed_periods_, skipped + 1);
+      diagnostics_.update();
+      return;
+    }
+    resuming_ = false;
   }
   if (options_.trigger == ControlTrigger::kTimer) {
     addSaturated(&missed_periods_, skipped);

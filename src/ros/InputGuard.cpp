@@ -97,7 +97,7 @@ void InputGuard::reject(Rejection kind, const std::string& detail) {
   ++unlogged_;
   run_length_ = kind == kind_ && run_length_ > 0 ? run_length_ + 1 : 1;
   kind_ = kind;
-  last_rejection_ = std::string(toString(kind)) + ": " + boundedText(detail, kMaxQuotedLength);
+  last_rejection_ = std::string(toString(kind)) + ": " + boundedText(detail, kMaxReasonLength);
   const Clock::time_point now = clock_();
   const bool transition = !have_logged_ || kind != logged_kind_;
   const Clock::duration since = now - last_log_;
@@ -117,6 +117,7 @@ void InputGuard::reject(Rejection kind, const std::string& detail) {
 void InputGuard::accept(std::int64_t stamp_ns, std::int64_t now_ns) {
   have_accepted_ = true;
   ever_accepted_ = true;
+  ++accepted_;
   last_stamp_ns_ = stamp_ns;
   effective_stamp_ns_ = std::min(stamp_ns, now_ns);
   last_rejection_.clear();

@@ -34,7 +34,7 @@ class Generator:
         self.frame = frame
         self.max_future = max_future
         self.max_age = max_age
-        self.sizes = sizes  # {field: entries}: the sizes the receiver accepts
+        self.sizes = sizes  # {field: (entries, ...)}: the sizes the receiver accepts, good first
         self.good_values = good_values
         self.last_accepted = None  # stamp of the last message the oracle accepted
         self.accepted = 0
@@ -62,7 +62,7 @@ class Generator:
         return self.good_stamp(now), self.frame, self.good_values(self.rng), True
 
     def extreme_finite(self, now):
-        vectors = {name: [self.rng.choice((1e308, -1e308, 5e-324, 1e30)) for _ in range(n)]
+        vectors = {name: [self.rng.choice((1e308, -1e308, 5e-324, 1e30)) for _ in range(n[0])]
                    for name, n in self.sizes.items()}
         return self.good_stamp(now), self.frame, vectors, True
 
@@ -96,14 +96,14 @@ class Generator:
     def wrong_size(self, now):
         vectors = self.good_values(self.rng)
         name = self.rng.choice(sorted(self.sizes))
-        wrong = self.rng.choice([n for n in (0, 2, 3, 7, 1000) if n != self.sizes[name]])
+        wrong = self.rng.choice([n for n in (0, 1, 2, 3, 7, 1000) if n not in self.sizes[name]])
         vectors[name] = [0.0] * wrong
         return self.good_stamp(now), self.frame, vectors, False
 
     def non_finite(self, now):
         vectors = self.good_values(self.rng)
         name = self.rng.choice(sorted(self.sizes))
-        vectors[name][0] = self.rng.choice((math.nan, math.inf, -math.inf))
+        vectors[name][0] = self.rng.choice((math.nan, math.inf, -math.inf))  # good sizes are > 0
         return self.good_stamp(now), self.frame, vectors, False
 
     def wrong_frame(self, now):
@@ -120,6 +120,6 @@ KINDS = [Generator.good, Generator.good, Generator.good, Generator.extreme_finit
 
 def any_values(rng, sizes):
     """Random vectors of arbitrary sizes and values, good or not (for inputs whose verdicts the
-    test does not count)."""
+    test does not count); `sizes`: {field: usual entries}."""
     return {name: [rng.choice((0.0, 1.0, -3.5, math.nan, math.inf, 1e300))
                    for _ in range(rng.choice((0, n, n, n, 5)))] for name, n in sizes.items()}

@@ -164,8 +164,7 @@ std::string trackerGainOf(const diagnostic_msgs::DiagnosticStatus& status) {
 
 TEST_F(FollowerTest, ReconfigureFrequencyZeroRestoresTheFilesGainAndNeverStoresNonFinite) {
   const double deadline = param("wall_deadline");
-  const auto gain_is = [this](const std::string& gain) {
-    const std::lock_guard<std::mutex> lock(mutex_);
+  const auto gain_is = [this](const std::string& gain) {  // called by waitFor() with mutex_ held
     return !follower_diagnostics_.empty() && trackerGainOf(follower_diagnostics_.back()) == gain;
   };
   // Run 2's G_e = [10, 5]; (omega_n, zeta) = (2, 0.7) gives [omega_n^2, 2 zeta omega_n].
@@ -179,16 +178,20 @@ TEST_F(FollowerTest, ReconfigureFrequencyZeroRestoresTheFilesGainAndNeverStoresN
   EXPECT_DOUBLE_EQ(doubleOf(restored, "tracker_natural_frequency"), 0.0);
   EXPECT_TRUE(waitFor([&] { return gain_is("[10, 5]"); }, deadline));
 
-  // Non-finite values are refused, whether or not they would be used, and never stored.
+  // NaN is refused, whether or not the value would be used, and never stored; an infinity is
+  // clamped by dynamic_reconfigure to the range of cfg/Follower.cfg before the node sees it.
   for (const char* name : {"alpha", "epsilon", "tracker_damping", "tracker_natural_frequency"}) {
     // The configuration in force, from a call that changes nothing.
     const double before = doubleOf(reconfigure("tracker_damping", 0.7, false, false), name);
-    for (const double bad : {std::nan(""), std::numeric_limits<double>::infinity()}) {
-      const dynamic_reconfigure::Config answer = reconfigure(name, bad, false, false);
-      EXPECT_TRUE(std::isfinite(doubleOf(answer, name))) << name;
-      EXPECT_DOUBLE_EQ(doubleOf(answer, name), before) << name;
-    }
+    const dynamic_reconfigure::Config refused = reconfigure(name, std::nan(""), false, false);
+    EXPECT_DOUBLE_EQ(doubleOf(refused, name), before) << name;
+    const dynamic_reconfigure::Config clamped =
+        reconfigure(name, std::numeric_limits<double>::infinity(), false, false);
+    EXPECT_TRUE(std::isfinite(doubleOf(clamped, name))) << name;
   }
+  reconfigure("epsilon", 0.2, false, false);
+  reconfigure("tracker_damping", 0.7, false, false);
+  reconfigure("tracker_natural_frequency", 0.0, false, false);
   EXPECT_TRUE(waitFor([&] { return gain_is("[10, 5]"); }, deadline));
 }
 

@@ -25,7 +25,6 @@ import unittest
 import xmlrpc.client
 
 import rosbag
-import rosnode
 import rospy
 import rostest
 from projection_collision_avoidance.msg import FollowerStatus, RelativeMeasurement
@@ -58,16 +57,17 @@ class TimeFaults(unittest.TestCase):
             return self.statuses[-1][1] if self.statuses else None
 
     def assert_honest(self, statuses):
-        for _, status in statuses:
+        for status in statuses:
             self.assertFalse(status.measurement_fresh and status.measurement_age < 0.0,
                              f"fresh with age {status.measurement_age}")
             if status.mode == FollowerStatus.MODE_TRACKING:
                 self.assertLessEqual(status.measurement_age, self.timeout)
             self.assertTrue(all(math.isfinite(u) for u in status.command))
 
-    def test_looping_bag(self):
-        if rospy.get_param("~case") != "looping_bag":
-            self.skipTest("another case")
+    def test_case(self):
+        getattr(self, "check_" + rospy.get_param("~case"))()
+
+    def check_looping_bag(self):
         start = 500.0
         with tempfile.TemporaryDirectory() as work:
             path = os.path.join(work, "measurements.bag")
@@ -89,22 +89,21 @@ class TimeFaults(unittest.TestCase):
                 player.wait(timeout=10)
         with self.lock:
             statuses = list(self.statuses)
-        self.assert_honest(statuses)
+        self.assert_honest([s for _, s in statuses])
         # After every jump back the follower tracks again.
         for jump in range(1, loops + 1):
             after = [s for _, s in statuses if s.time_jumps == jump]
             self.assertTrue(any(s.mode == FollowerStatus.MODE_TRACKING for s in after),
                             f"no tracking after jump {jump}")
 
-    def test_stall(self):
-        if rospy.get_param("~case") != "stall":
-            self.skipTest("another case")
+    def check_stall(self):
         node = rospy.get_param("~follower_node")
         self.wait_for(lambda: self.latest() is not None and
                       self.latest().mode == FollowerStatus.MODE_TRACKING and
                       self.latest().header.stamp.to_sec() > 5.0, "the follower does not track")
-        api = rosnode.get_api_uri(rospy.get_master(), node)
-        pid = xmlrpc.client.ServerProxy(api).getPid("/test_time_faults")[2]
+        code, _, api = rospy.get_master().lookupNode(node)
+        self.assertEqual(code, 1, f"{node} unknown to the master")
+        pid = xmlrpc.client.ServerProxy(api).getPid(rospy.get_name())[2]
         before = self.latest()
         os.kill(pid, signal.SIGSTOP)
         try:

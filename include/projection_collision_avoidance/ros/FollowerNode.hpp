@@ -87,8 +87,9 @@ struct FollowerNodeOptions {
 /// (InputGuard), and so is a message whose judging throws: no input ends the node. When ROS time
 /// goes back (ClockWatch), the inputs of the old timeline are forgotten and the follower brakes
 /// until fresh measurements arrive. A tick that runs more than half ~measurement_timeout late
-/// (the process itself was stalled) is skipped and counted as missed: the input queued meanwhile
-/// decides the next one. dynamic_reconfigure changes the tracker switch, alpha, epsilon and the
+/// (the process itself was stalled) is skipped, and so are the ticks after it until a
+/// measurement arrives or half ~measurement_timeout has passed (all counted as missed): the
+/// input sent while the process stood still decides the next step, not its absence. dynamic_reconfigure changes the tracker switch, alpha, epsilon and the
 /// tracker gain (frequency 0: the scenario file's gain); a set the controller design refuses,
 /// or with a non-finite value, is rejected and the old one kept.
 ///
@@ -167,6 +168,9 @@ class FollowerNode {
   Eigen::VectorXd leader_input_;  ///< a_1 of the latest accepted leader broadcast
   InputGuard leader_guard_;
   ClockWatch clock_;  ///< jumps back of ROS time
+  bool resuming_ = false;            ///< a stall was seen; waiting for input (see controlTick)
+  ros::Time resumed_at_;             ///< when the stall was seen
+  std::uint64_t accepted_at_stall_ = 0;  ///< measurements accepted when the stall was seen
   FollowerMode mode_ = FollowerMode::kWaiting;  ///< of the latest tick
   bool leader_fresh_ = false;                   ///< at the latest tick
   double last_xi_norm_ = 0.0;

@@ -47,8 +47,10 @@ struct InputGuardLimits {
 /// everAccepted() still tells that the input was heard.
 class InputGuard {
  public:
-  /// Length to which a frame_id or reason is cut in logs and diagnostics (characters).
+  /// Length to which a frame_id (or other text a sender controls) is cut when quoted (bytes).
   static constexpr std::size_t kMaxQuotedLength = 64;
+  /// Length to which a reason is cut in logs and diagnostics (bytes).
+  static constexpr std::size_t kMaxReasonLength = 256;
   /// Shortest interval between two log lines for a change of kind.
   static constexpr std::chrono::seconds kTransitionPeriod{1};
   /// Interval of the summary log line while refusals of the logged kind go on.
@@ -65,7 +67,7 @@ class InputGuard {
   /// content and calls accept() or reject().
   bool checkHeader(const std::string& frame_id, std::int64_t stamp_ns, std::int64_t now_ns);
 
-  /// Counts a refusal of @p kind; @p detail (cut to kMaxQuotedLength) says what was wrong.
+  /// Counts a refusal of @p kind; @p detail (cut to kMaxReasonLength) says what was wrong.
   void reject(Rejection kind, const std::string& detail);
 
   /// Records an accepted message stamped @p stamp_ns, received at @p now_ns.
@@ -85,6 +87,8 @@ class InputGuard {
   /// when there is none on this timeline.
   double ageAt(std::int64_t now_ns) const;
 
+  /// Messages accepted since start.
+  std::uint64_t accepted() const { return accepted_; }
   /// Refusals since start.
   std::uint64_t rejected() const { return rejected_; }
   /// Refusals of the current kind since it began.
@@ -103,6 +107,7 @@ class InputGuard {
   std::int64_t last_stamp_ns_ = 0;
   std::int64_t effective_stamp_ns_ = 0;
   Clock::time_point (*clock_)() = &Clock::now;
+  std::uint64_t accepted_ = 0;
   std::uint64_t rejected_ = 0;
   Rejection kind_ = Rejection::kContent;         ///< kind of the latest refusal
   std::uint64_t run_length_ = 0;                 ///< refusals of kind_ in a row (accepts ignored)
