@@ -149,11 +149,12 @@ FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh, const
     }
   }
   // A message older than its timeout on arrival could only be stale: refused as such.
-  measurement_guard_ =
-      InputGuard("relative_measurement", {options_.measurement_frame, options_.max_future_stamp,
-                                          options_.measurement_timeout});
-  leader_guard_ = InputGuard("leader_broadcast", {options_.leader_broadcast_frame,
-                                                  options_.max_future_stamp, options_.leader_timeout});
+  measurement_guard_ = InputGuard(
+      "relative_measurement",
+      {options_.measurement_frame, options_.max_future_stamp, options_.measurement_timeout});
+  leader_guard_ = InputGuard(
+      "leader_broadcast",
+      {options_.leader_broadcast_frame, options_.max_future_stamp, options_.leader_timeout});
   const std::string name = private_nh_.getNamespace();
   echoScenario(name, private_nh);
   reader.echo(name);
@@ -222,10 +223,7 @@ void FollowerNode::onMeasurement(const RelativeMeasurement::ConstPtr& msg) {
   const std::lock_guard<std::mutex> lock(mutex_);
   admitGuarded(measurement_guard_, private_nh_.getNamespace(), [&] {
     const ros::Time now = ros::Time::now();
-    if (clock_.wentBack(now)) {
-      onTimeJump(now);
-    }
-    if (!checkHeader(measurement_guard_, msg->header, now)) {
+    if (!admitHeader(measurement_guard_, msg->header, now)) {
       return;
     }
     std::string why;
@@ -236,7 +234,7 @@ void FollowerNode::onMeasurement(const RelativeMeasurement::ConstPtr& msg) {
     const bool triggered = options_.trigger == ControlTrigger::kMeasurement;
     if (triggered && measurement_guard_.haveAccepted()) {
       const double gap = 1e-9 * static_cast<double>(nanosecondsOf(msg->header.stamp) -
-                                                     measurement_guard_.lastStamp());
+                                                    measurement_guard_.lastStamp());
       addSaturated(&missed_periods_, skippedPeriods(gap, period_));
     }
     measurement_guard_.accept(nanosecondsOf(msg->header.stamp), nanosecondsOf(now));
@@ -250,10 +248,7 @@ void FollowerNode::onLeaderBroadcast(const LeaderBroadcast::ConstPtr& msg) {
   const std::lock_guard<std::mutex> lock(mutex_);
   admitGuarded(leader_guard_, private_nh_.getNamespace(), [&] {
     const ros::Time now = ros::Time::now();
-    if (clock_.wentBack(now)) {
-      onTimeJump(now);
-    }
-    if (!checkHeader(leader_guard_, msg->header, now)) {
+    if (!admitHeader(leader_guard_, msg->header, now)) {
       return;
     }
     std::string why;
@@ -266,6 +261,14 @@ void FollowerNode::onLeaderBroadcast(const LeaderBroadcast::ConstPtr& msg) {
     leader_input_ = controller_.design().leaderAcceleration(input, disturbance);
     leader_guard_.accept(nanosecondsOf(msg->header.stamp), nanosecondsOf(now));
   });
+}
+
+bool FollowerNode::admitHeader(InputGuard& guard, const std_msgs::Header& header,
+                               const ros::Time& now) {
+  if (clock_.wentBack(now)) {
+    onTimeJump(now);
+  }
+  return checkHeader(guard, header, now);
 }
 
 void FollowerNode::onTimeJump(const ros::Time& now) {
@@ -580,11 +583,9 @@ void FollowerNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
   status.add("rejected_measurements", measurement_guard_.rejected());
   status.add("rejected_leader_broadcasts", leader_guard_.rejected());
   const std::int64_t now_ns = nanosecondsOf(ros::Time::now());
-  status.add("measurement_age (s)", measurement_guard_.haveAccepted()
-                                        ? measurement_guard_.ageAt(now_ns)
-                                        : -1.0);
-  status.add("leader_age (s)",
-             leader_guard_.haveAccepted() ? leader_guard_.ageAt(now_ns) : -1.0);
+  status.add("measurement_age (s)",
+             measurement_guard_.haveAccepted() ? measurement_guard_.ageAt(now_ns) : -1.0);
+  status.add("leader_age (s)", leader_guard_.haveAccepted() ? leader_guard_.ageAt(now_ns) : -1.0);
   status.add("time_jumps", clock_.jumps());
   status.add("trigger", toString(options_.trigger));
   status.add("control_loop", toString(options_.control_loop));
@@ -614,7 +615,8 @@ void FollowerNode::onReconfigure(FollowerConfig& config, uint32_t /*level*/) {
   candidate.epsilon = config.epsilon;
   try {
     for (const auto& [name, value] :
-         {std::pair<const char*, double>{"alpha", config.alpha}, {"epsilon", config.epsilon},
+         {std::pair<const char*, double>{"alpha", config.alpha},
+          {"epsilon", config.epsilon},
           {"tracker_natural_frequency", config.tracker_natural_frequency},
           {"tracker_damping", config.tracker_damping}}) {
       if (!std::isfinite(value)) {
@@ -638,13 +640,12 @@ void FollowerNode::onReconfigure(FollowerConfig& config, uint32_t /*level*/) {
     }
     controller_.setDesign(ControllerDesign::create(candidate));
     parameters_ = candidate;
-    ROS_INFO_STREAM(private_nh_.getNamespace()
-                    << ": reconfigured: tracker " << (candidate.tracker_enabled ? "on" : "off")
-                    << ", alpha " << candidate.alpha << ", epsilon " << candidate.epsilon
-                    << ", tracker gain "
-                    << (config.tracker_natural_frequency > 0.0 ? "from the frequency"
-                                                               : "of the scenario file")
-                    << ", xi_max " << controller_.design().xi_max << " m");
+    ROS_INFO_STREAM(
+        private_nh_.getNamespace()
+        << ": reconfigured: tracker " << (candidate.tracker_enabled ? "on" : "off") << ", alpha "
+        << candidate.alpha << ", epsilon " << candidate.epsilon << ", tracker gain "
+        << (config.tracker_natural_frequency > 0.0 ? "from the frequency" : "of the scenario file")
+        << ", xi_max " << controller_.design().xi_max << " m");
     applied_config_ = config;
   } catch (const ParameterError& error) {
     ROS_ERROR_STREAM(private_nh_.getNamespace()

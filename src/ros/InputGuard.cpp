@@ -51,8 +51,7 @@ std::string boundedText(const std::string& text, std::size_t length) {
   return text.substr(0, length) + "... (" + std::to_string(text.size()) + " bytes)";
 }
 
-InputGuard::InputGuard(std::string topic, InputGuardLimits limits,
-                       Clock::time_point (*clock)())
+InputGuard::InputGuard(std::string topic, InputGuardLimits limits, Clock::time_point (*clock)())
     : topic_(std::move(topic)), limits_(std::move(limits)), clock_(clock) {}
 
 bool InputGuard::checkHeader(const std::string& frame_id, std::int64_t stamp_ns,

@@ -288,8 +288,8 @@ void PlantNode::rosTick() {
     // Under use_sim_time scenario time is ROS time; otherwise it starts at the first tick.
     started_ = true;
     origin_ = ros::Time::isSimTime() ? ros::Time(0) : now;
-    next_tick_ = static_cast<long>(
-        std::ceil(secondsBetween(now, origin_) * options_.rate - kTickTolerance));
+    next_tick_ =
+        static_cast<long>(std::ceil(secondsBetween(now, origin_) * options_.rate - kTickTolerance));
     if (last_tick_ >= 0 && next_tick_ > last_tick_) {
       std::ostringstream why;
       why << "ROS time " << now.toSec() << " s is already past ~duration = " << options_.duration
@@ -298,8 +298,8 @@ void PlantNode::rosTick() {
       return;
     }
   }
-  const long due = static_cast<long>(
-      std::floor(secondsBetween(now, origin_) * options_.rate + kTickTolerance));
+  const long due =
+      static_cast<long>(std::floor(secondsBetween(now, origin_) * options_.rate + kTickTolerance));
   if (due < next_tick_ - 1) {
     return;  // ROS time went back: wait for it to reach the next tick again
   }
@@ -434,10 +434,9 @@ void PlantNode::publishMarkers(const ros::Time& stamp) {
 
 GenericDimensions::InputVector PlantNode::commandAt(Agent* agent, const ros::Time& now) {
   const InputGuard& guard = agent->command_guard;
-  const bool fresh =
-      guard.haveAccepted() &&
-      std::abs(1e-9 * static_cast<double>(nanosecondsOf(now) - guard.lastStamp())) <=
-          options_.command_timeout;
+  const bool fresh = guard.haveAccepted() &&
+                     std::abs(1e-9 * static_cast<double>(nanosecondsOf(now) - guard.lastStamp())) <=
+                         options_.command_timeout;
   if (fresh) {
     if (agent->command_timed_out) {
       ROS_INFO_STREAM(name_ << ": " << agent->name << "/command fresh again");

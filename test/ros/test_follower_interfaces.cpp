@@ -170,7 +170,8 @@ TEST_F(FollowerTest, ReconfigureFrequencyZeroRestoresTheFilesGainAndNeverStoresN
   // Run 2's G_e = [10, 5]; (omega_n, zeta) = (2, 0.7) gives [omega_n^2, 2 zeta omega_n].
   ASSERT_TRUE(waitFor([&] { return gain_is("[10, 5]"); }, deadline));
   reconfigure("tracker_damping", 0.7, false, false);
-  const dynamic_reconfigure::Config set = reconfigure("tracker_natural_frequency", 2.0, false, false);
+  const dynamic_reconfigure::Config set =
+      reconfigure("tracker_natural_frequency", 2.0, false, false);
   EXPECT_DOUBLE_EQ(doubleOf(set, "tracker_natural_frequency"), 2.0);
   EXPECT_TRUE(waitFor([&] { return gain_is("[4, 2.8]"); }, deadline));
   const dynamic_reconfigure::Config restored =

@@ -28,6 +28,7 @@ from projection_collision_avoidance.msg import (FollowerStatus, LeaderBroadcast,
 from rosgraph_msgs.msg import Clock
 
 import hostile_messages as hostile
+import ros_test_helpers as helpers
 
 PACKAGE = "projection_collision_avoidance"
 START = 1000.0  # s of simulated time at which the test's clock starts
@@ -97,6 +98,7 @@ class HostileInputs(unittest.TestCase):
         cls.odometry = pub("/leader/odom", Odometry)
         cls.clock = pub("/clock", Clock)
         cls.now = START
+        cls.last_good = None  # stamp (s) of the test's latest good measurement
         cls.clock_lock = threading.Lock()
         cls.running = True
         cls.clock_thread = threading.Thread(target=cls.run_clock, daemon=True)
@@ -121,12 +123,7 @@ class HostileInputs(unittest.TestCase):
             return HostileInputs.now
 
     def wait_for(self, condition, what):
-        end = time.monotonic() + self.deadline
-        while time.monotonic() < end and not rospy.is_shutdown():
-            if condition():
-                return
-            time.sleep(0.01)
-        self.assertTrue(condition(), f"{what} (seed {self.seed})")
+        helpers.wait_for(self, condition, f"{what} (seed {self.seed})", self.deadline)
 
     def connected(self, publisher):
         self.wait_for(lambda: publisher.get_num_connections() > 0, f"{publisher.name} unheard")
@@ -138,7 +135,12 @@ class HostileInputs(unittest.TestCase):
         self.measurements.publish(msg)
 
     def good_measurement(self):
-        self.send_measurement(hostile.to_time(self.clock_now() - 0.05), "world",
+        """A measurement on the slot, stamped after every good one before it."""
+        stamp = self.clock_now() - 0.05
+        if HostileInputs.last_good is not None and HostileInputs.last_good < self.clock_now():
+            stamp = max(stamp, HostileInputs.last_good + 0.001)
+        HostileInputs.last_good = stamp
+        self.send_measurement(hostile.to_time(stamp), "world",
                               {"position": [5.0], "velocity": [0.0]})
 
     def track(self):
@@ -167,56 +169,71 @@ class HostileInputs(unittest.TestCase):
         self.assertLess(self.record.largest_diagnostics, 20000,
                         "diagnostics grow with what senders send")
 
+    def barrage(self, generator, send, refused, sentinel, seen):
+        """Sends a good `sentinel` message (marked), waits until the follower has taken it, then
+        the generator's messages, then another sentinel: once that is taken the follower has
+        judged everything before it, in order, and its count `refused(status)` must have grown by
+        exactly what the contract refuses."""
+        def take_sentinel(mark):
+            stamp = generator.good_stamp(self.clock_now())
+            generator.last_accepted = stamp
+            sentinel(stamp, mark)
+            self.wait_for(lambda: seen(self.record.latest(), mark), f"sentinel {mark} not taken")
+        if HostileInputs.last_good is not None:
+            generator.last_accepted = hostile.to_time(HostileInputs.last_good)
+        take_sentinel(0.4321)
+        before = refused(self.record.latest())
+        for _ in range(rospy.get_param("~messages")):
+            kind, stamp, frame, vectors, accepted = generator.draw(self.clock_now())
+            send(stamp, frame, vectors)
+            time.sleep(0.004)
+        take_sentinel(0.1234)
+        counted = refused(self.record.latest()) - before
+        self.assertEqual(counted, generator.refused,
+                         f"{counted} refused, the contract refuses {generator.refused} of "
+                         f"{generator.refused + generator.accepted} (seed {self.seed})")
+        HostileInputs.last_good = hostile.stamp_seconds(generator.last_accepted)
+
     def test_1_measurements_refused_exactly_as_the_contract_says(self):
         self.connected(self.measurements)
         self.track()
-        before = self.record.latest().rejected_measurements
         generator = hostile.Generator(
             self.rng, "world", max_future=0.1, max_age=0.5,
             sizes={"position": (1,), "velocity": (1,)},
             good_values=lambda rng: {"position": [rng.uniform(3, 7)],
                                      "velocity": [rng.uniform(-1, 1)]})
-        generator.last_accepted = None  # the good measurements above were older than any below
-        time.sleep(0.1)
-        for _ in range(rospy.get_param("~messages")):
-            kind, stamp, frame, vectors, accepted = generator.draw(self.clock_now())
-            self.send_measurement(stamp, frame, vectors)
-            time.sleep(0.004)
-        expected = before + generator.refused
-        self.wait_for(lambda: self.record.latest().rejected_measurements >= expected,
-                      f"{self.record.latest().rejected_measurements - before} measurements "
-                      f"refused, the contract refuses {generator.refused}")
-        time.sleep(0.5)
-        self.assertEqual(self.record.latest().rejected_measurements, expected,
-                         f"seed {self.seed}")
+        # Sentinels: positions 5 + mark, which no generated message has (xi = mark).
+        self.barrage(generator, self.send_measurement,
+                     lambda status: status.rejected_measurements,
+                     lambda stamp, mark: self.send_measurement(
+                         stamp, "world", {"position": [5.0 + mark], "velocity": [0.0]}),
+                     lambda status, mark: abs(status.xi[0] - mark) < 1e-9)
         self.track()
         self.assert_alive_and_sane()
+
+    def send_broadcast(self, stamp, frame, vectors):
+        msg = LeaderBroadcast()
+        msg.header.stamp, msg.header.frame_id = stamp, frame
+        for name, values in vectors.items():
+            setattr(msg, name, values)
+        self.broadcasts.publish(msg)
+        self.good_measurement()  # the broadcast is used while the measurement is fresh
 
     def test_2_leader_broadcasts_refused_exactly_as_the_contract_says(self):
         self.connected(self.broadcasts)
         self.track()
-        before = self.record.latest().rejected_leader_broadcasts
         generator = hostile.Generator(
             self.rng, "world", max_future=0.1, max_age=0.5,
             sizes={"position": (1,), "velocity": (1,), "input": (1,), "disturbance": (2, 0)},
             good_values=lambda rng: {"position": [rng.uniform(-5, 5)], "velocity": [0.0],
                                      "input": [rng.uniform(-1, 1)], "disturbance": [0.0, 0.0]})
-        for _ in range(rospy.get_param("~messages")):
-            kind, stamp, frame, vectors, accepted = generator.draw(self.clock_now())
-            msg = LeaderBroadcast()
-            msg.header.stamp, msg.header.frame_id = stamp, frame
-            for name, values in vectors.items():
-                setattr(msg, name, values)
-            self.broadcasts.publish(msg)
-            self.good_measurement()
-            time.sleep(0.004)
-        expected = before + generator.refused
-        self.wait_for(lambda: self.record.latest().rejected_leader_broadcasts >= expected,
-                      f"{self.record.latest().rejected_leader_broadcasts - before} broadcasts "
-                      f"refused, the contract refuses {generator.refused}")
-        time.sleep(0.5)
-        self.assertEqual(self.record.latest().rejected_leader_broadcasts, expected,
-                         f"seed {self.seed}")
+        # Sentinels: a leader input no generated message has, fed forward into the command.
+        self.barrage(generator, self.send_broadcast,
+                     lambda status: status.rejected_leader_broadcasts,
+                     lambda stamp, mark: self.send_broadcast(stamp, "world", {
+                         "position": [0.0], "velocity": [0.0], "input": [mark],
+                         "disturbance": [0.0, 0.0]}),
+                     lambda status, mark: abs(status.feedforward_command[0] - mark) < 1e-9)
         self.assert_alive_and_sane()
 
     def test_3_plant_and_leader_survive_anything(self):

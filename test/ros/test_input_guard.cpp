@@ -47,8 +47,8 @@ TEST(InputGuard, RefusesZeroFutureStaleOutOfOrderAndRepeatedStamps) {
 
 TEST(InputGuard, JudgesStampsOverTheWholeRangeOfRosTime) {
   for (const std::int64_t now : {std::int64_t{1}, 1700000000 * kSecond, kLatest}) {
-    for (const std::int64_t stamp : {std::int64_t{1}, kSecond, 1700000000 * kSecond, kLatest - 1,
-                                     kLatest}) {
+    for (const std::int64_t stamp :
+         {std::int64_t{1}, kSecond, 1700000000 * kSecond, kLatest - 1, kLatest}) {
       for (const double max_age : {0.0, 0.5}) {
         InputGuard guard = makeGuard(0.1, max_age);
         const bool ahead = stamp - now > kSecond / 10;
@@ -104,8 +104,7 @@ TEST(InputGuard, LogsOncePerChangeOfKindWithCounts) {
   EXPECT_FALSE(guard.checkHeader("world", 0, now));
   const std::string line = guard.takeLogLine();
   EXPECT_NE(line.find("zero stamp"), std::string::npos) << line;
-  EXPECT_NE(line.find("1001 refusals since the last line, 1002 in all"), std::string::npos)
-      << line;
+  EXPECT_NE(line.find("1001 refusals since the last line, 1002 in all"), std::string::npos) << line;
   // The same kind goes on: a summary once per summary period.
   for (int i = 0; i < 100; ++i) {
     EXPECT_FALSE(guard.checkHeader("world", 0, now));
@@ -129,7 +128,8 @@ TEST(InputGuard, TextsFromSendersAreBounded) {
 
 TEST(AdmitGuarded, AMessageThatCannotBeJudgedIsCountedNotFatal) {
   InputGuard guard = makeGuard();
-  admitGuarded(guard, "test", [] { throw std::runtime_error("Duration is out of dual 32-bit range"); });
+  admitGuarded(guard, "test",
+               [] { throw std::runtime_error("Duration is out of dual 32-bit range"); });
   admitGuarded(guard, "test", [] { throw 42; });
   EXPECT_EQ(guard.rejected(), 2U);
   EXPECT_EQ(guard.lastRejection().rfind("unjudgeable", 0), 0U);

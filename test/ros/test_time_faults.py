@@ -29,6 +29,8 @@ import rospy
 import rostest
 from projection_collision_avoidance.msg import FollowerStatus, RelativeMeasurement
 
+import ros_test_helpers as helpers
+
 PACKAGE = "projection_collision_avoidance"
 
 
@@ -45,12 +47,7 @@ class TimeFaults(unittest.TestCase):
             self.statuses.append((time.monotonic(), msg))
 
     def wait_for(self, condition, what):
-        end = time.monotonic() + self.deadline
-        while time.monotonic() < end and not rospy.is_shutdown():
-            if condition():
-                return
-            time.sleep(0.01)
-        self.assertTrue(condition(), what)
+        helpers.wait_for(self, condition, f"{what}", self.deadline)
 
     def latest(self):
         with self.lock:

@@ -89,9 +89,10 @@ struct FollowerNodeOptions {
 /// until fresh measurements arrive. A tick that runs more than half ~measurement_timeout late
 /// (the process itself was stalled) is skipped, and so are the ticks after it until a
 /// measurement arrives or half ~measurement_timeout has passed (all counted as missed): the
-/// input sent while the process stood still decides the next step, not its absence. dynamic_reconfigure changes the tracker switch, alpha, epsilon and the
-/// tracker gain (frequency 0: the scenario file's gain); a set the controller design refuses,
-/// or with a non-finite value, is rejected and the old one kept.
+/// input sent while the process stood still decides the next step, not its absence.
+/// dynamic_reconfigure changes the tracker switch, alpha, epsilon and the tracker gain (frequency
+/// 0: the scenario file's gain); a set the controller design refuses, or with a non-finite value,
+/// is rejected and the old one kept.
 ///
 /// ~trigger decides what runs a control step. "timer" (default): a timer every 1 / control_rate s
 /// (ROS time), on the latest accepted measurement; the step is stamped with the timer's time, so
@@ -142,6 +143,8 @@ class FollowerNode {
   /// command, broadcast, status, markers, diagnostics. The one code path of both triggers.
   void controlStep(const ros::Time& stamp, double delay);
   void onReconfigure(FollowerConfig& config, uint32_t level);
+  /// Notes a jump back of ROS time at @p now, then judges @p header with @p guard (mutex_ held).
+  bool admitHeader(InputGuard& guard, const std_msgs::Header& header, const ros::Time& now);
   /// ROS time went back to @p now (mutex_ held): forget the inputs of the old timeline.
   void onTimeJump(const ros::Time& now);
   void publishStatus(const ros::Time& now, const Eigen::VectorXd& xi, double measurement_age);
@@ -156,7 +159,7 @@ class FollowerNode {
   ros::NodeHandle private_nh_;
   NodeOptionReader reader_;  ///< the private options, read once
   FollowerNodeOptions options_;
-  FormationMember member_;           ///< this follower's place in the formation
+  FormationMember member_;                ///< this follower's place in the formation
   ControllerParameters file_parameters_;  ///< as the scenario gave them
   ControllerParameters parameters_;       ///< as currently in force (scenario + reconfigure)
   RuntimeFollowerController controller_;
@@ -167,9 +170,9 @@ class FollowerNode {
   InputGuard measurement_guard_;
   Eigen::VectorXd leader_input_;  ///< a_1 of the latest accepted leader broadcast
   InputGuard leader_guard_;
-  ClockWatch clock_;  ///< jumps back of ROS time
-  bool resuming_ = false;            ///< a stall was seen; waiting for input (see controlTick)
-  ros::Time resumed_at_;             ///< when the stall was seen
+  ClockWatch clock_;                     ///< jumps back of ROS time
+  bool resuming_ = false;                ///< a stall was seen; waiting for input (see controlTick)
+  ros::Time resumed_at_;                 ///< when the stall was seen
   std::uint64_t accepted_at_stall_ = 0;  ///< measurements accepted when the stall was seen
   FollowerMode mode_ = FollowerMode::kWaiting;  ///< of the latest tick
   bool leader_fresh_ = false;                   ///< at the latest tick

@@ -60,7 +60,8 @@ class InputGuard {
   InputGuard() = default;
   /// @param topic the input's name in log lines
   /// @param clock time source of the log intervals (a test's own, or the steady clock)
-  InputGuard(std::string topic, InputGuardLimits limits, Clock::time_point (*clock)() = &Clock::now);
+  InputGuard(std::string topic, InputGuardLimits limits,
+             Clock::time_point (*clock)() = &Clock::now);
 
   /// Checks a header at the receiver's time @p now_ns: frame, zero stamp, future, stale, order.
   /// Returns false after counting a refusal (see takeLogLine()); on true the caller checks the
@@ -109,12 +110,12 @@ class InputGuard {
   Clock::time_point (*clock_)() = &Clock::now;
   std::uint64_t accepted_ = 0;
   std::uint64_t rejected_ = 0;
-  Rejection kind_ = Rejection::kContent;         ///< kind of the latest refusal
-  std::uint64_t run_length_ = 0;                 ///< refusals of kind_ in a row (accepts ignored)
+  Rejection kind_ = Rejection::kContent;  ///< kind of the latest refusal
+  std::uint64_t run_length_ = 0;          ///< refusals of kind_ in a row (accepts ignored)
   bool have_logged_ = false;
   Rejection logged_kind_ = Rejection::kContent;  ///< kind of the last log line
   Clock::time_point last_log_;
-  std::uint64_t unlogged_ = 0;                   ///< refusals since the last log line
+  std::uint64_t unlogged_ = 0;  ///< refusals since the last log line
   std::string last_rejection_;
   std::string log_line_;
 };
