@@ -192,6 +192,8 @@ class HostileInputs(unittest.TestCase):
         self.assertEqual(counted, generator.refused,
                          f"{counted} refused, the contract refuses {generator.refused} of "
                          f"{generator.refused + generator.accepted} (seed {self.seed})")
+        rospy.loginfo("hostile_inputs: %d of %d refused, as the contract says (seed %d)", counted,
+                      generator.refused + generator.accepted, self.seed)
         HostileInputs.last_good = hostile.stamp_seconds(generator.last_accepted)
 
     def test_1_measurements_refused_exactly_as_the_contract_says(self):
