@@ -1,9 +1,11 @@
 #pragma once
 
+#include <cmath>
 #include <stdexcept>
 
 #include "projection_collision_avoidance/BallConstraint.hpp"
 #include "projection_collision_avoidance/ControllerDesign.hpp"
+#include "projection_collision_avoidance/ParameterError.hpp"
 #include "projection_collision_avoidance/ProjectionOperator.hpp"
 #include "projection_collision_avoidance/TypeDefs.hpp"
 
@@ -36,7 +38,9 @@ struct ContinuousLoopSignals {
 /// with y = C (x_1 - x_2 - d), a_1 = u_1 [+ pinv(B) u_d] and u_ff = a_1 as configured by
 /// controller.leader_information (else 0), and Proj the Gamma^-1-weighted operator of the notes.
 /// sat() is the controller's: none unless controller.acceleration_limit is set. The same
-/// equations as FollowerController, except that u_a and y are not held over a period.
+/// equations as FollowerController, except that u_a and y are not held over a period. The
+/// controller's rate limit (controller.jerk_limit), a bound per control period, has no
+/// counterpart here and is refused.
 template <typename Dims>
 class ContinuousClosedLoop {
  public:
@@ -46,7 +50,8 @@ class ContinuousClosedLoop {
   using State = ContinuousLoopState<Dims>;
   using Signals = ContinuousLoopSignals<Dims>;
 
-  /// @param design validated parameters whose sizes fit Dims (std::invalid_argument otherwise)
+  /// @param design validated parameters whose sizes fit Dims (std::invalid_argument otherwise),
+  ///        without a jerk_limit (ParameterError("controller.jerk_limit") otherwise)
   explicit ContinuousClosedLoop(const ControllerDesign& design)
       : constraint_(design.xi_max, design.parameters.epsilon),
         acceleration_limit_(design.parameters.acceleration_limit),
@@ -57,6 +62,11 @@ class ContinuousClosedLoop {
     const AgentModel& model = design.parameters.model;
     if (!Dims::fits(model.stateDimension(), model.inputDimension(), model.outputDimension())) {
       throw std::invalid_argument("ContinuousClosedLoop: model sizes do not fit the dimensions");
+    }
+    if (std::isfinite(design.parameters.jerk_limit)) {
+      throw ParameterError("controller.jerk_limit",
+                           "the continuous-time loop has no control period to limit the "
+                           "command's change over; remove the key or run the sampled loop");
     }
     state_matrix_ = model.A;
     input_matrix_ = model.B;

@@ -32,9 +32,10 @@ struct ControllerDesign {
 
   /// Validates @p parameters and derives the design. Throws ParameterError with the key of the
   /// first failing check: sizes and finiteness of every matrix, alpha in [0, 1), epsilon > 0,
-  /// d != 0 and A d = 0, control_rate > 0, substeps in [1, 1000], Q = Q^T > 0, and A_c,
-  /// A_c + L C, A_c - B G_e C Hurwitz (the message lists the eigenvalues), K_f of size m x n,
-  /// finite, with no eigenvalue of A - B K_f in the open right half-plane.
+  /// acceleration_limit and jerk_limit > 0 (or infinite), d != 0 and A d = 0, control_rate > 0,
+  /// substeps in [1, 1000], Q = Q^T > 0, and A_c, A_c + L C, A_c - B G_e C Hurwitz (the message
+  /// lists the eigenvalues), K_f of size m x n, finite, with no eigenvalue of A - B K_f in the open
+  /// right half-plane.
   static ControllerDesign create(const ControllerParameters& parameters);
 
   /// The leader's acceleration as shared with the follower: a_1 = u_1 + pinv(B) u_d when

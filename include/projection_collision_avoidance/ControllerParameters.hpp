@@ -41,6 +41,10 @@ struct ControllerParameters {
   /// Bound on the command's norm ||u_2|| (m/s^2 for double integrators); a larger command is
   /// scaled onto it. Infinity: no bound.
   double acceleration_limit = std::numeric_limits<double>::infinity();
+  /// Bound on the command's rate of change (m/s^3 for double integrators): after saturation,
+  /// ||u_2(k) - u_2(k-1)|| <= jerk_limit T, in tracking and fallback steps alike, with u_2 = 0
+  /// before the first step. Infinity: no bound.
+  double jerk_limit = std::numeric_limits<double>::infinity();
   /// Gain K_f (m x n) of the fallback that runs while no measurement arrives:
   /// u_2 = sat(u_ff + K_f xi_hat), xi_hat predicted without correction. Empty: the default,
   /// [0, I / s] for double integrators (brake the relative velocity with a 1 s time constant),

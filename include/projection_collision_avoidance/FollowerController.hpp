@@ -3,6 +3,7 @@
 #include "projection_collision_avoidance/BallConstraint.hpp"
 #include "projection_collision_avoidance/CollisionFreeEstimator.hpp"
 #include "projection_collision_avoidance/CollisionFreeTracker.hpp"
+#include "projection_collision_avoidance/CommandRateLimiter.hpp"
 #include "projection_collision_avoidance/ControllerDesign.hpp"
 #include "projection_collision_avoidance/TypeDefs.hpp"
 
@@ -11,7 +12,8 @@ namespace projection_collision_avoidance {
 /// Everything the follower computed at one control tick.
 template <typename Dims>
 struct FollowerControllerStatus {
-  typename Dims::InputVector command;  ///< u_2 = baseline + tracker + feed-forward, saturated
+  /// u_2 = baseline + tracker + feed-forward, saturated, then rate limited
+  typename Dims::InputVector command;
   typename Dims::InputVector baseline_command;     ///< G y (2)
   typename Dims::InputVector tracker_command;      ///< u_a (19)
   typename Dims::InputVector feedforward_command;  ///< u_1 when shared into the command, else 0
@@ -19,7 +21,10 @@ struct FollowerControllerStatus {
   typename Dims::StateVector estimate;             ///< xi_hat used at this tick (m)
   double estimate_norm = 0.0;                      ///< ||xi_hat|| (m), euclideanNorm()
   double constraint_value = 0.0;                   ///< f(xi_hat) (13)
-  bool command_saturated = false;    ///< the sum exceeded acceleration_limit and was scaled
+  bool command_saturated = false;  ///< the sum exceeded acceleration_limit and was scaled
+  /// The saturated command was more than jerk_limit T from the previous one and was moved to
+  /// that distance from it.
+  bool command_rate_limited = false;
   bool fallback = false;             ///< this tick ran the fallback (no usable measurement)
   bool projection_active = false;    ///< the projection acted during the period that follows
   double boundary_correction = 0.0;  ///< see EstimatorPeriodReport (m)
@@ -40,15 +45,19 @@ struct FollowerControllerStatus {
 /// tracks the CF estimator (11)-(15). One step() per control period T.
 ///
 /// At a tick with measurement y = C xi the command is
-///   u_2 = sat(G y + u_a + u_ff),   u_a = G_e (y - C xi_hat) + S_21 C xi_hat,
+///   u_2 = rate(sat(G y + u_a + u_ff)),   u_a = G_e (y - C xi_hat) + S_21 C xi_hat,
 /// computed from the current estimate, where sat() scales a vector longer than
-/// acceleration_limit onto it. The estimate is then integrated over [t, t + T] with y held and
-/// the augmentation that actually acts, u_2 - G y - u_ff (u_a when not saturated), so that its
-/// model of xi' stays that of the plant. Without a measurement stepFallback() brakes relative to
-/// the leader from the predicted estimate instead. A step allocates no memory.
+/// acceleration_limit onto it and rate() moves it to within jerk_limit T of the previous tick's
+/// command (CommandRateLimiter; zero before the first tick). The estimate is then integrated
+/// over [t, t + T] with y held and the augmentation that actually acts, u_2 - G y - u_ff (u_a
+/// when neither limit acted), so that its model of xi' stays that of the plant. Without a
+/// measurement stepFallback() brakes relative to the leader from the predicted estimate instead,
+/// under the same two limits, so that a change of mode cannot jump the command. A step allocates
+/// no memory.
 ///
 /// Whatever the inputs, after every call the command is finite with euclideanNorm(u_2) <=
-/// acceleration_limit, and the estimate is finite with euclideanNorm(xi_hat) <= xi_max: a
+/// acceleration_limit and euclideanNorm(u_2 - u_2 of the previous call) <= jerk_limit T, and
+/// the estimate is finite with euclideanNorm(xi_hat) <= xi_max: a
 /// non-finite measurement is treated as missing, a non-finite u_1 as unknown, a command that
 /// overflows is replaced by a finite one, and an estimator substep that overflows is discarded;
 /// each is flagged in the status.
@@ -68,7 +77,10 @@ class FollowerController {
         output_matrix_(design.parameters.model.C),
         baseline_gain_(design.parameters.baseline_gain),
         output_pseudoinverse_(design.output_pseudoinverse),
-        fallback_gain_(design.fallback_gain) {
+        fallback_gain_(design.fallback_gain),
+        rate_limiter_(design.parameters.jerk_limit, design.period,
+                      design.parameters.acceleration_limit,
+                      design.parameters.model.inputDimension()) {
     status_.command = InputVector::Zero(design.parameters.model.inputDimension());
     status_.baseline_command = status_.command;
     status_.tracker_command = status_.command;
@@ -102,12 +114,13 @@ class FollowerController {
 
   /// One control period without a measurement: the fallback. The command brakes relative to
   /// the leader from the estimate, which is predicted by the model alone and stays in Omega_1:
-  ///   u_2 = sat(u_ff + K_f xi_hat),   xi_hat' = Proj(A xi_hat + B (u_1m - u_2)),
+  ///   u_2 = rate(sat(u_ff + K_f xi_hat)),   xi_hat' = Proj(A xi_hat + B (u_1m - u_2)),
   /// with u_ff and u_1m the leader input as shared into the command and the estimator (0 when
   /// unknown). For the default K_f = [0, k_v I] of a double integrator the predicted relative
   /// velocity decays as e^{-k_v t} and the relative position comes to rest. Before any
   /// measurement the estimate is the one the next step() would replace, zero. If u_ff + K_f
-  /// xi_hat overflows (huge gains), the command is u_ff alone, saturated (command_overflow).
+  /// xi_hat overflows (huge gains), the command is u_ff alone, saturated and rate limited
+  /// (command_overflow).
   const FollowerControllerStatus<Dims>& stepFallback() {
     return tick(nullptr, InputVector::Zero(input_matrix_.cols()), false);
   }
@@ -118,11 +131,15 @@ class FollowerController {
     return tick(nullptr, leader_input, true);
   }
 
-  /// Forgets the estimate; the next step initialises it as configured.
-  void reset() { initialized_ = false; }
+  /// Forgets the estimate and the previous command (back to zero, a vehicle at rest); the next
+  /// step initialises the estimate as configured.
+  void reset() {
+    initialized_ = false;
+    rate_limiter_.reset();
+  }
 
   /// Sets the estimate (projected into Omega_1; zero if not finite) and marks the controller
-  /// initialised.
+  /// initialised. The previous command is kept.
   void resetEstimate(const StateVector& estimate) {
     estimator_.reset(estimate);
     initialized_ = true;
@@ -133,6 +150,15 @@ class FollowerController {
 
   /// The estimate that the next step will use (m).
   const StateVector& estimate() const { return estimator_.estimate(); }
+
+  /// The command of the last step, from which the next one may change by at most jerk_limit T
+  /// (m/s^2 for double integrators); zero before the first step and after reset().
+  const InputVector& previousCommand() const { return rate_limiter_.previous(); }
+
+  /// Sets the previous command (moved into ||u|| <= acceleration_limit; zero if not finite), for
+  /// example to carry it over to a controller with a new design.
+  void setPreviousCommand(const InputVector& command) { rate_limiter_.setPrevious(command); }
+
   const FollowerControllerStatus<Dims>& status() const { return status_; }
   const ControllerDesign& design() const { return design_; }
   const CollisionFreeEstimator<Dims>& estimator() const { return estimator_; }
@@ -199,9 +225,9 @@ class FollowerController {
     status_.constraint_value = estimator_.constraint().value(estimate);
     status_.fallback_command.setZero();
     status_.fallback = false;
-    saturateCommand();
+    limitCommand();
     InputVector acting_augmentation = status_.tracker_command;
-    if (status_.command_saturated) {
+    if (status_.command_saturated || status_.command_rate_limited) {
       acting_augmentation =
           status_.command - status_.baseline_command - status_.feedforward_command;
     }
@@ -233,7 +259,7 @@ class FollowerController {
       status_.fallback_command.setZero();
       status_.command = status_.feedforward_command;
     }
-    saturateCommand();
+    limitCommand();
 
     // xi' = A xi + B (u_1 - u_ff) - B (u_2 - u_ff), with u_1 - u_ff modelled as in step().
     const StateVector drift = knownDrift(leader_input, leader_input_known) -
@@ -262,10 +288,12 @@ class FollowerController {
   }
 
   /// Scales the finite status_.command onto acceleration_limit when it is longer (clampNorm():
-  /// no overflow, and euclideanNorm(command) <= acceleration_limit exactly).
-  void saturateCommand() {
+  /// no overflow, and euclideanNorm(command) <= acceleration_limit exactly), then limits its
+  /// change from the previous tick's command to jerk_limit T, inside the same ball.
+  void limitCommand() {
     status_.command_saturated =
         clampNorm(status_.command, design_.parameters.acceleration_limit) > 0.0;
+    status_.command_rate_limited = rate_limiter_.limit(status_.command);
   }
 
   ControllerDesign design_;
@@ -276,6 +304,7 @@ class FollowerController {
   typename Dims::FeedbackGainMatrix baseline_gain_;         // G
   typename Dims::ObserverGainMatrix output_pseudoinverse_;  // pinv(C)
   typename Dims::StateGainMatrix fallback_gain_;            // K_f
+  CommandRateLimiter<InputVector> rate_limiter_;            // jerk_limit, from u_2(k-1)
   FollowerControllerStatus<Dims> status_;
   bool initialized_ = false;
 };

@@ -22,6 +22,7 @@ struct RuntimeFollowerStatus {
   double estimate_norm = 0.0;           ///< ||xi_hat|| (m)
   double constraint_value = 0.0;        ///< f(xi_hat) (13)
   bool command_saturated = false;       ///< the command was scaled onto acceleration_limit
+  bool command_rate_limited = false;    ///< the command's change was limited to jerk_limit T
   bool fallback = false;                ///< this tick ran the fallback (no usable measurement)
   bool projection_active = false;
   double boundary_correction = 0.0;    ///< (m)
@@ -56,16 +57,22 @@ class RuntimeFollowerController {
   const RuntimeFollowerStatus& stepFallback(const Eigen::Ref<const Eigen::VectorXd>& leader_input);
 
   /// Replaces the parameters (for example from dynamic_reconfigure) and keeps the estimate,
-  /// moved into the new Omega_1. Throws std::invalid_argument if the model's sizes change.
+  /// moved into the new Omega_1, and the previous command, moved into the new acceleration
+  /// limit, from which the next command's change is limited. Throws std::invalid_argument if the
+  /// model's sizes change.
   void setDesign(const ControllerDesign& design);
 
-  /// Forgets the estimate; the next step initialises it as configured.
+  /// Forgets the estimate and the previous command (zero, a vehicle at rest); the next step
+  /// initialises the estimate as configured.
   void reset();
 
   const ControllerDesign& design() const;
   const RuntimeFollowerStatus& status() const { return status_; }
   /// The estimate the next step will use (m).
   Eigen::VectorXd estimate() const;
+  /// The command of the last step (zero before the first and after reset()), from which the next
+  /// may change by at most jerk_limit T (m/s^2 for double integrators).
+  Eigen::VectorXd previousCommand() const;
   int stateDimension() const { return design().parameters.model.stateDimension(); }
   int inputDimension() const { return design().parameters.model.inputDimension(); }
   int outputDimension() const { return design().parameters.model.outputDimension(); }

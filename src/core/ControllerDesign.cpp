@@ -46,6 +46,10 @@ void validateScalars(const ControllerParameters& p) {
     throw ParameterError("controller.acceleration_limit", "must be positive (m/s^2) or .inf, got " +
                                                               std::to_string(p.acceleration_limit));
   }
+  if (!(p.jerk_limit > 0.0)) {  // also refuses NaN; infinity means no bound
+    throw ParameterError("controller.jerk_limit",
+                         "must be positive (m/s^3) or .inf, got " + std::to_string(p.jerk_limit));
+  }
   if (p.estimator_substeps < 1 || p.estimator_substeps > kMaxEstimatorSubsteps) {
     throw ParameterError("controller.estimator.substeps",
                          "must be between 1 and " + std::to_string(kMaxEstimatorSubsteps) +

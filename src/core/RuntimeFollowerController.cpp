@@ -19,6 +19,7 @@ void copyStatus(const FollowerControllerStatus<Dims>& from, RuntimeFollowerStatu
   to->estimate_norm = from.estimate_norm;
   to->constraint_value = from.constraint_value;
   to->command_saturated = from.command_saturated;
+  to->command_rate_limited = from.command_rate_limited;
   to->fallback = from.fallback;
   to->projection_active = from.projection_active;
   to->boundary_correction = from.boundary_correction;
@@ -102,18 +103,19 @@ void RuntimeFollowerController::setDesign(const ControllerDesign& design) {
     throw std::invalid_argument("RuntimeFollowerController::setDesign: model sizes changed");
   }
   const Eigen::VectorXd kept = estimate();
+  const Eigen::VectorXd kept_command = previousCommand();
   const bool initialized =
       std::visit([](const auto& controller) { return controller.initialized(); }, controller_);
   Variant replacement = makeController(design);
-  if (!initialized) {
-    controller_ = std::move(replacement);
-    return;
-  }
   std::visit(
-      [&kept](auto& controller) {
+      [&](auto& controller) {
         using Controller = std::decay_t<decltype(controller)>;
-        const typename Controller::StateVector estimate = kept;
-        controller.resetEstimate(estimate);
+        const typename Controller::InputVector command = kept_command;
+        controller.setPreviousCommand(command);
+        if (initialized) {
+          const typename Controller::StateVector estimate = kept;
+          controller.resetEstimate(estimate);
+        }
       },
       replacement);
   controller_ = std::move(replacement);
@@ -132,6 +134,12 @@ const ControllerDesign& RuntimeFollowerController::design() const {
 Eigen::VectorXd RuntimeFollowerController::estimate() const {
   return std::visit([](const auto& controller) -> Eigen::VectorXd { return controller.estimate(); },
                     controller_);
+}
+
+Eigen::VectorXd RuntimeFollowerController::previousCommand() const {
+  return std::visit(
+      [](const auto& controller) -> Eigen::VectorXd { return controller.previousCommand(); },
+      controller_);
 }
 
 }  // namespace projection_collision_avoidance

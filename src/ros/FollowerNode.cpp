@@ -129,11 +129,10 @@ FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh, const
       private_nh_(private_nh),
       reader_(private_nh),
       member_(memberOf(reader_, scenario)),
-      parameters_(memberParameters(scenario.controller, member_)),
+      file_parameters_(memberParameters(scenario.controller, member_)),
+      parameters_(file_parameters_),
       controller_(ControllerDesign::create(parameters_)),
       axes_(parameters_.model.double_integrator_axes),
-      measurement_guard_("relative_measurement", "", 0.0),
-      leader_guard_("leader_broadcast", "", 0.0),
       diagnostics_(nh, private_nh),
       reconfigure_server_(reconfigure_mutex_, private_nh) {
   NodeOptionReader& reader = reader_;
@@ -149,10 +148,13 @@ FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh, const
               "process's size)");
     }
   }
-  measurement_guard_ =
-      InputGuard("relative_measurement", options_.measurement_frame, options_.max_future_stamp);
-  leader_guard_ =
-      InputGuard("leader_broadcast", options_.leader_broadcast_frame, options_.max_future_stamp);
+  // A message older than its timeout on arrival could only be stale: refused as such.
+  measurement_guard_ = InputGuard(
+      "relative_measurement",
+      {options_.measurement_frame, options_.max_future_stamp, options_.measurement_timeout});
+  leader_guard_ = InputGuard(
+      "leader_broadcast",
+      {options_.leader_broadcast_frame, options_.max_future_stamp, options_.leader_timeout});
   const std::string name = private_nh_.getNamespace();
   echoScenario(name, private_nh);
   reader.echo(name);
@@ -219,41 +221,64 @@ FollowerNode::~FollowerNode() {
 
 void FollowerNode::onMeasurement(const RelativeMeasurement::ConstPtr& msg) {
   const std::lock_guard<std::mutex> lock(mutex_);
-  const ros::Time now = ros::Time::now();
-  if (!measurement_guard_.checkHeader(msg->header, now)) {
-    return;
-  }
-  std::string why;
-  if (!relativeStateFromMsg(*msg, axes_, &relative_state_, &why)) {
-    measurement_guard_.reject(why);
-    return;
-  }
-  const bool triggered = options_.trigger == ControlTrigger::kMeasurement;
-  if (triggered && measurement_guard_.haveAccepted()) {
-    addSaturated(
-        &missed_periods_,
-        skippedPeriods((msg->header.stamp - measurement_guard_.lastStamp()).toSec(), period_));
-  }
-  measurement_guard_.accept(msg->header.stamp);
-  if (triggered) {
-    controlStep(msg->header.stamp, (now - msg->header.stamp).toSec());
-  }
+  admitGuarded(measurement_guard_, private_nh_.getNamespace(), [&] {
+    const ros::Time now = ros::Time::now();
+    if (!admitHeader(measurement_guard_, msg->header, now)) {
+      return;
+    }
+    std::string why;
+    if (!relativeStateFromMsg(*msg, axes_, &relative_state_, &why)) {
+      measurement_guard_.reject(Rejection::kContent, why);
+      return;
+    }
+    const bool triggered = options_.trigger == ControlTrigger::kMeasurement;
+    if (triggered && measurement_guard_.haveAccepted()) {
+      const double gap = 1e-9 * static_cast<double>(nanosecondsOf(msg->header.stamp) -
+                                                    measurement_guard_.lastStamp());
+      addSaturated(&missed_periods_, skippedPeriods(gap, period_));
+    }
+    measurement_guard_.accept(nanosecondsOf(msg->header.stamp), nanosecondsOf(now));
+    if (triggered) {
+      controlStep(msg->header.stamp, secondsBetween(now, msg->header.stamp));
+    }
+  });
 }
 
 void FollowerNode::onLeaderBroadcast(const LeaderBroadcast::ConstPtr& msg) {
   const std::lock_guard<std::mutex> lock(mutex_);
-  if (!leader_guard_.checkHeader(msg->header, ros::Time::now())) {
-    return;
+  admitGuarded(leader_guard_, private_nh_.getNamespace(), [&] {
+    const ros::Time now = ros::Time::now();
+    if (!admitHeader(leader_guard_, msg->header, now)) {
+      return;
+    }
+    std::string why;
+    Eigen::VectorXd input;
+    Eigen::VectorXd disturbance;
+    if (!leaderInputFromMsg(*msg, axes_, &input, &disturbance, &why)) {
+      leader_guard_.reject(Rejection::kContent, why);
+      return;
+    }
+    leader_input_ = controller_.design().leaderAcceleration(input, disturbance);
+    leader_guard_.accept(nanosecondsOf(msg->header.stamp), nanosecondsOf(now));
+  });
+}
+
+bool FollowerNode::admitHeader(InputGuard& guard, const std_msgs::Header& header,
+                               const ros::Time& now) {
+  if (clock_.wentBack(now)) {
+    onTimeJump(now);
   }
-  std::string why;
-  Eigen::VectorXd input;
-  Eigen::VectorXd disturbance;
-  if (!leaderInputFromMsg(*msg, axes_, &input, &disturbance, &why)) {
-    leader_guard_.reject(why);
-    return;
-  }
-  leader_input_ = controller_.design().leaderAcceleration(input, disturbance);
-  leader_guard_.accept(msg->header.stamp);
+  return checkHeader(guard, header, now);
+}
+
+void FollowerNode::onTimeJump(const ros::Time& now) {
+  ROS_WARN_STREAM(private_nh_.getNamespace()
+                  << ": ROS time went back by " << -clock_.jump() << " s, to " << now.toSec()
+                  << " s: the inputs of the old timeline are forgotten; braking until fresh "
+                     "measurements arrive");
+  measurement_guard_.restartTimeline();
+  leader_guard_.restartTimeline();
+  have_last_expected_ = false;
 }
 
 void FollowerNode::logModeChange(FollowerMode mode) {
@@ -278,27 +303,37 @@ void FollowerNode::logModeChange(FollowerMode mode) {
 }
 
 FollowerMode FollowerNode::modeAt(const ros::Time& now, FollowerInputAges* ages) const {
-  ages->have_measurement = measurement_guard_.haveAccepted();
-  ages->measurement_age = (now - measurement_guard_.lastStamp()).toSec();
-  ages->have_leader = leader_guard_.haveAccepted();
-  ages->leader_age = (now - leader_guard_.lastStamp()).toSec();
+  // After a jump back of ROS time an input heard before has no age on the new timeline
+  // (+infinity): stale, so the follower brakes rather than waits.
+  ages->have_measurement = measurement_guard_.everAccepted();
+  ages->measurement_age = measurement_guard_.ageAt(nanosecondsOf(now));
+  ages->have_leader = leader_guard_.everAccepted();
+  ages->leader_age = leader_guard_.ageAt(nanosecondsOf(now));
   return selectFollowerMode(
       *ages, FollowerTimeouts{options_.measurement_timeout, options_.leader_timeout});
 }
 
 void FollowerNode::onControlTick(const ros::TimerEvent& event) {
   const std::lock_guard<std::mutex> lock(mutex_);
-  const ros::Time now = ros::Time::now();
-  const double delay = (event.current_real - event.current_expected).toSec();
-  std::uint32_t skipped = 0;
-  if (options_.trigger == ControlTrigger::kTimer) {
-    if (have_last_expected_) {
-      skipped = skippedPeriods((event.current_expected - last_expected_).toSec(), period_);
+  try {
+    const ros::Time now = ros::Time::now();
+    if (clock_.wentBack(now)) {
+      onTimeJump(now);
     }
-    last_expected_ = event.current_expected;
-    have_last_expected_ = true;
+    const double delay = secondsBetween(event.current_real, event.current_expected);
+    std::uint32_t skipped = 0;
+    if (options_.trigger == ControlTrigger::kTimer) {
+      if (have_last_expected_) {
+        skipped = skippedPeriods(secondsBetween(event.current_expected, last_expected_), period_);
+      }
+      last_expected_ = event.current_expected;
+      have_last_expected_ = true;
+    }
+    controlTick(now, delay, skipped);
+  } catch (const std::exception& error) {
+    ROS_ERROR_STREAM_THROTTLE(5.0, private_nh_.getNamespace()
+                                       << ": control tick failed: " << error.what());
   }
-  controlTick(now, delay, skipped);
 }
 
 void FollowerNode::onLoopTick(const PeriodicTick& tick) {
@@ -306,13 +341,43 @@ void FollowerNode::onLoopTick(const PeriodicTick& tick) {
     return;
   }
   const std::lock_guard<std::mutex> lock(mutex_);
-  const ros::Time now = ros::Time::now();
-  const double delay = 1e-9 * static_cast<double>(tick.actual - tick.expected);
-  const std::uint64_t most = std::numeric_limits<std::uint32_t>::max();
-  controlTick(now, delay, static_cast<std::uint32_t>(std::min(tick.skipped, most)));
+  try {
+    const ros::Time now = ros::Time::now();
+    if (clock_.wentBack(now)) {
+      onTimeJump(now);
+    }
+    const double delay = 1e-9 * static_cast<double>(tick.actual - tick.expected);
+    const std::uint64_t most = std::numeric_limits<std::uint32_t>::max();
+    controlTick(now, delay, static_cast<std::uint32_t>(std::min(tick.skipped, most)));
+  } catch (const std::exception& error) {
+    ROS_ERROR_STREAM_THROTTLE(5.0, private_nh_.getNamespace()
+                                       << ": control tick failed: " << error.what());
+  }
 }
 
 void FollowerNode::controlTick(const ros::Time& now, double delay, std::uint32_t skipped) {
+  const double grace = 0.5 * options_.measurement_timeout;
+  if (delay > grace) {
+    // The tick itself ran late by a good part of the timeout: the process was stalled, and the
+    // measurements sent meanwhile are not read yet. Judging their age now would brake for
+    // nothing: wait for them (at most `grace` s) before deciding.
+    resuming_ = true;
+    resumed_at_ = now;
+    accepted_at_stall_ = measurement_guard_.accepted();
+    ROS_WARN_STREAM_THROTTLE(5.0, private_nh_.getNamespace()
+                                      << ": control tick " << delay
+                                      << " s late (the process was stalled): waiting up to "
+                                      << grace << " s for the input sent meanwhile");
+  }
+  if (resuming_) {
+    if (measurement_guard_.accepted() == accepted_at_stall_ &&
+        secondsBetween(now, resumed_at_) < grace) {
+      addSaturated(&missed_periods_, skipped + 1);
+      diagnostics_.update();
+      return;
+    }
+    resuming_ = false;
+  }
   if (options_.trigger == ControlTrigger::kTimer) {
     addSaturated(&missed_periods_, skipped);
     controlStep(now, delay);
@@ -386,7 +451,7 @@ void FollowerNode::publishStatus(const ros::Time& now, const Eigen::VectorXd& xi
   msg.mode = static_cast<uint8_t>(mode_);
   msg.mode_name = toString(mode_);
   msg.fallback = s.fallback;
-  msg.measurement_fresh = mode_ != FollowerMode::kMeasurementLost;
+  msg.measurement_fresh = mode_ == FollowerMode::kTracking || mode_ == FollowerMode::kLeaderLost;
   msg.measurement_age = measurement_age;
   msg.rejected_measurements = measurement_guard_.rejected();
   msg.leader_fresh = leader_fresh_;
@@ -402,6 +467,8 @@ void FollowerNode::publishStatus(const ros::Time& now, const Eigen::VectorXd& xi
   msg.projection_active = s.projection_active;
   msg.command_saturated = s.command_saturated;
   msg.acceleration_limit = parameters_.acceleration_limit;
+  msg.command_rate_limited = s.command_rate_limited;
+  msg.jerk_limit = parameters_.jerk_limit;
   msg.tracker_enabled = parameters_.tracker_enabled;
   msg.command = toStdVector(s.command);
   msg.baseline_command = toStdVector(s.baseline_command);
@@ -414,6 +481,7 @@ void FollowerNode::publishStatus(const ros::Time& now, const Eigen::VectorXd& xi
   msg.missed_periods = missed_periods_;
   msg.late_periods = late_periods_;
   msg.tick_delay = tick_delay_;
+  msg.time_jumps = clock_.jumps();
   status_publisher_.publish(msg);
 }
 
@@ -505,15 +573,20 @@ void FollowerNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
   status.add("projection_active", s.projection_active);
   status.add("command_saturated", s.command_saturated);
   status.add("acceleration_limit (m/s^2)", parameters_.acceleration_limit);
+  status.add("command_rate_limited", s.command_rate_limited);
+  status.add("jerk_limit (m/s^3)", parameters_.jerk_limit);
   status.add("tracker_enabled", parameters_.tracker_enabled);
+  std::ostringstream gain;  // G_e in force, row by row
+  gain << parameters_.tracker_gain.format(
+      Eigen::IOFormat(Eigen::StreamPrecision, Eigen::DontAlignCols, ", ", "; ", "", "", "[", "]"));
+  status.add("tracker_gain", gain.str());
   status.add("rejected_measurements", measurement_guard_.rejected());
   status.add("rejected_leader_broadcasts", leader_guard_.rejected());
-  const ros::Time now = ros::Time::now();
-  status.add("measurement_age (s)", measurement_guard_.haveAccepted()
-                                        ? (now - measurement_guard_.lastStamp()).toSec()
-                                        : -1.0);
-  status.add("leader_age (s)",
-             leader_guard_.haveAccepted() ? (now - leader_guard_.lastStamp()).toSec() : -1.0);
+  const std::int64_t now_ns = nanosecondsOf(ros::Time::now());
+  status.add("measurement_age (s)",
+             measurement_guard_.haveAccepted() ? measurement_guard_.ageAt(now_ns) : -1.0);
+  status.add("leader_age (s)", leader_guard_.haveAccepted() ? leader_guard_.ageAt(now_ns) : -1.0);
+  status.add("time_jumps", clock_.jumps());
   status.add("trigger", toString(options_.trigger));
   status.add("control_loop", toString(options_.control_loop));
   status.add("control_priority", options_.control_priority);
@@ -541,6 +614,20 @@ void FollowerNode::onReconfigure(FollowerConfig& config, uint32_t /*level*/) {
   candidate.alpha = config.alpha;
   candidate.epsilon = config.epsilon;
   try {
+    for (const auto& [name, value] :
+         {std::pair<const char*, double>{"alpha", config.alpha},
+          {"epsilon", config.epsilon},
+          {"tracker_natural_frequency", config.tracker_natural_frequency},
+          {"tracker_damping", config.tracker_damping}}) {
+      if (!std::isfinite(value)) {
+        throw ParameterError(name, "must be finite, got " + std::to_string(value));
+      }
+    }
+    if (config.tracker_natural_frequency < 0.0) {
+      throw ParameterError("tracker_natural_frequency",
+                           "must be >= 0 (0: the scenario's gain), got " +
+                               std::to_string(config.tracker_natural_frequency));
+    }
     if (config.tracker_natural_frequency > 0.0) {
       if (!candidate.model.C.isIdentity(0.0)) {
         throw ParameterError("tracker_natural_frequency", "needs C = identity");
@@ -548,13 +635,17 @@ void FollowerNode::onReconfigure(FollowerConfig& config, uint32_t /*level*/) {
       candidate.tracker_gain = doubleIntegratorGain(
           Eigen::VectorXd::Constant(axes_, config.tracker_natural_frequency),
           Eigen::VectorXd::Constant(axes_, config.tracker_damping), "tracker_natural_frequency");
+    } else {
+      candidate.tracker_gain = file_parameters_.tracker_gain;  // 0: the scenario file's gain
     }
     controller_.setDesign(ControllerDesign::create(candidate));
     parameters_ = candidate;
-    ROS_INFO_STREAM(private_nh_.getNamespace()
-                    << ": reconfigured: tracker " << (candidate.tracker_enabled ? "on" : "off")
-                    << ", alpha " << candidate.alpha << ", epsilon " << candidate.epsilon
-                    << ", xi_max " << controller_.design().xi_max << " m");
+    ROS_INFO_STREAM(
+        private_nh_.getNamespace()
+        << ": reconfigured: tracker " << (candidate.tracker_enabled ? "on" : "off") << ", alpha "
+        << candidate.alpha << ", epsilon " << candidate.epsilon << ", tracker gain "
+        << (config.tracker_natural_frequency > 0.0 ? "from the frequency" : "of the scenario file")
+        << ", xi_max " << controller_.design().xi_max << " m");
     applied_config_ = config;
   } catch (const ParameterError& error) {
     ROS_ERROR_STREAM(private_nh_.getNamespace()

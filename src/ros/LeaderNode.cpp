@@ -46,23 +46,28 @@ LeaderNode::LeaderNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
 
 void LeaderNode::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
   const std::lock_guard<std::mutex> lock(mutex_);
-  if (!odometry_guard_.checkHeader(msg->header, ros::Time::now())) {
-    return;
-  }
-  if (msg->child_frame_id != options_.leader_frame) {
-    odometry_guard_.reject("child_frame_id '" + msg->child_frame_id + "', expected '" +
-                           options_.leader_frame + "'");
-    return;
-  }
-  Eigen::VectorXd state;
-  if (!stateFromOdometryMsg(*msg, axes_, &state)) {
-    odometry_guard_.reject("non-finite position or velocity");
-    return;
-  }
-  odometry_ = *msg;
-  state_ = state;
-  have_odometry_ = true;
-  odometry_guard_.accept(msg->header.stamp);
+  admitGuarded(odometry_guard_, name_, [&] {
+    const ros::Time now = ros::Time::now();
+    if (!checkHeader(odometry_guard_, msg->header, now)) {
+      return;
+    }
+    if (msg->child_frame_id != options_.leader_frame) {
+      odometry_guard_.reject(Rejection::kContent,
+                             "child_frame_id '" +
+                                 boundedText(msg->child_frame_id, InputGuard::kMaxQuotedLength) +
+                                 "', expected '" + options_.leader_frame + "'");
+      return;
+    }
+    Eigen::VectorXd state;
+    if (!stateFromOdometryMsg(*msg, axes_, &state)) {
+      odometry_guard_.reject(Rejection::kContent, "non-finite position or velocity");
+      return;
+    }
+    odometry_ = *msg;
+    state_ = state;
+    have_odometry_ = true;
+    odometry_guard_.accept(nanosecondsOf(msg->header.stamp), nanosecondsOf(now));
+  });
 }
 
 void LeaderNode::onTick(const ros::TimerEvent& event) {
@@ -79,14 +84,14 @@ void LeaderNode::onTick(const ros::TimerEvent& event) {
     ROS_WARN_STREAM(name_ << ": ROS time went back from " << last_stamp_.toSec() << " s to "
                           << stamp.toSec() << " s");
     have_odometry_ = false;
-    odometry_guard_ = InputGuard("leader/odom", "", kMaxFutureStamp);
+    odometry_guard_.restartTimeline();
   }
   last_stamp_ = stamp;
   if (!started_) {
     started_ = true;
     origin_ = ros::Time::isSimTime() ? ros::Time(0) : stamp;
   }
-  const double t = (stamp - origin_).toSec();
+  const double t = secondsBetween(stamp, origin_);
   const Eigen::VectorXd input = scenario_.leader_input.value(t, axes_);
   command_publisher_.publish(toAccelMsg(input, stamp, options_.leader_frame));
   if (!have_odometry_) {

@@ -1,12 +1,14 @@
 /// The three nodes as nodelets: each owns the same class the stand-alone node runs.
 
 #include <exception>
+#include <iostream>
 #include <memory>
 
 #include <nodelet/nodelet.h>
 #include <pluginlib/class_list_macros.hpp>
 
 #include "projection_collision_avoidance/ParameterError.hpp"
+#include "projection_collision_avoidance/ScenarioLoader.hpp"
 #include "projection_collision_avoidance/ros/FollowerNode.hpp"
 #include "projection_collision_avoidance/ros/LeaderNode.hpp"
 #include "projection_collision_avoidance/ros/PlantNode.hpp"
@@ -15,13 +17,17 @@ namespace projection_collision_avoidance {
 
 /// Runs Node(node handle, private node handle) inside a nodelet manager. A refused parameter is
 /// logged with its key, any other failure with its message, and the load fails (the manager's
-/// process is not ended).
+/// process is not ended). A scenario load cancelled by the manager's shutdown is reported on
+/// stderr, roscpp's logging being off by then.
 template <typename Node>
 class NodeletOf : public nodelet::Nodelet {
  private:
   void onInit() override {
     try {
       node_ = std::make_unique<Node>(getNodeHandle(), getPrivateNodeHandle());
+    } catch (const ScenarioLoadCancelled& cancelled) {
+      std::cerr << getName() << ": not started: " << cancelled.what() << std::endl;
+      throw;
     } catch (const ParameterError& error) {
       NODELET_FATAL_STREAM(getName() << ": invalid parameter " << error.what());
       throw;

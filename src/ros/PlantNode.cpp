@@ -96,7 +96,7 @@ PlantNode::Agent::Agent(const std::string& agent_name, const std::string& tf_fra
       frame(tf_frame),
       integrator(model, step, initial_state, disturbance),
       command(Eigen::VectorXd::Zero(model.inputDimension())),
-      command_guard(agent_name + "/command", tf_frame, command_timeout) {}
+      command_guard(agent_name + "/command", {tf_frame, command_timeout, command_timeout}) {}
 
 PlantNode::PlantNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
     : nh_(nh),
@@ -199,21 +199,23 @@ void PlantNode::onCommand(Agent* agent, const geometry_msgs::AccelStamped::Const
   const std::lock_guard<std::mutex> lock(mutex_);
   // A command stamped ahead of the plant's time by more than ~command_timeout would never time
   // out: its sender's clock is not the plant's (a wall-time stamp under simulated time, say).
-  const ros::Time now = started_ ? stampOf(std::max(0L, next_tick_ - 1)) : ros::Time::now();
-  if (!agent->command_guard.checkHeader(msg->header, now)) {
-    return;
-  }
-  std::string why;
-  Eigen::VectorXd command;
-  if (!commandFromAccelMsg(*msg, axes_, &command, &why)) {
-    agent->command_guard.reject(why);
-    return;
-  }
-  if (!agent->command_guard.haveAccepted()) {
-    ROS_INFO_STREAM(name_ << ": first " << agent->name << "/command received");
-  }
-  agent->command = command;
-  agent->command_guard.accept(msg->header.stamp);
+  admitGuarded(agent->command_guard, name_, [&] {
+    const ros::Time now = started_ ? stampOf(std::max(0L, next_tick_ - 1)) : ros::Time::now();
+    if (!checkHeader(agent->command_guard, msg->header, now)) {
+      return;
+    }
+    std::string why;
+    Eigen::VectorXd command;
+    if (!commandFromAccelMsg(*msg, axes_, &command, &why)) {
+      agent->command_guard.reject(Rejection::kContent, why);
+      return;
+    }
+    if (!agent->command_guard.everAccepted()) {
+      ROS_INFO_STREAM(name_ << ": first " << agent->name << "/command received");
+    }
+    agent->command = command;
+    agent->command_guard.accept(nanosecondsOf(msg->header.stamp), nanosecondsOf(now));
+  });
 }
 
 ros::Time PlantNode::stampOf(long k) const {
@@ -260,16 +262,34 @@ void PlantNode::onWallTick(const ros::WallTimerEvent& /*event*/) {
 
 void PlantNode::onRosTick(const ros::TimerEvent& /*event*/) {
   const std::lock_guard<std::mutex> lock(mutex_);
+  try {
+    rosTick();
+  } catch (const std::exception& error) {
+    ROS_ERROR_STREAM_THROTTLE(5.0, name_ << ": tick failed: " << error.what());
+  }
+}
+
+void PlantNode::rosTick() {
   const ros::Time now = ros::Time::now();
   if (!running_ || now.isZero()) {
     return;
+  }
+  if (clock_.wentBack(now)) {
+    // A restarted /clock: commands of the new timeline are judged afresh.
+    ROS_WARN_STREAM(name_ << ": ROS time went back by " << -clock_.jump() << " s, to "
+                          << now.toSec() << " s; waiting for it to reach "
+                          << stampOf(next_tick_).toSec() << " s again");
+    leader_.command_guard.restartTimeline();
+    for (Follower& follower : followers_) {
+      follower.agent.command_guard.restartTimeline();
+    }
   }
   if (!started_) {
     // Under use_sim_time scenario time is ROS time; otherwise it starts at the first tick.
     started_ = true;
     origin_ = ros::Time::isSimTime() ? ros::Time(0) : now;
     next_tick_ =
-        static_cast<long>(std::ceil((now - origin_).toSec() * options_.rate - kTickTolerance));
+        static_cast<long>(std::ceil(secondsBetween(now, origin_) * options_.rate - kTickTolerance));
     if (last_tick_ >= 0 && next_tick_ > last_tick_) {
       std::ostringstream why;
       why << "ROS time " << now.toSec() << " s is already past ~duration = " << options_.duration
@@ -279,12 +299,9 @@ void PlantNode::onRosTick(const ros::TimerEvent& /*event*/) {
     }
   }
   const long due =
-      static_cast<long>(std::floor((now - origin_).toSec() * options_.rate + kTickTolerance));
+      static_cast<long>(std::floor(secondsBetween(now, origin_) * options_.rate + kTickTolerance));
   if (due < next_tick_ - 1) {
-    ROS_WARN_STREAM_THROTTLE(5.0, name_ << ": ROS time went back to " << now.toSec()
-                                        << " s; waiting for it to reach "
-                                        << stampOf(next_tick_).toSec() << " s again");
-    return;
+    return;  // ROS time went back: wait for it to reach the next tick again
   }
   // Catch up every due tick, at most one second of them per call.
   const long limit = next_tick_ + std::max(1L, std::lround(options_.rate));
@@ -377,7 +394,7 @@ void PlantNode::publishMeasurement(Follower* follower, long k, const ros::Time& 
   const double latency_ticks = options_.latency * options_.rate;
   while (!follower->pending.empty()) {
     const RelativeMeasurement& oldest = follower->pending.front();
-    const double sampled_tick = (oldest.header.stamp - origin_).toSec() * options_.rate;
+    const double sampled_tick = secondsBetween(oldest.header.stamp, origin_) * options_.rate;
     if (static_cast<double>(k) - sampled_tick < latency_ticks - kTickTolerance) {
       break;
     }
@@ -418,7 +435,8 @@ void PlantNode::publishMarkers(const ros::Time& stamp) {
 GenericDimensions::InputVector PlantNode::commandAt(Agent* agent, const ros::Time& now) {
   const InputGuard& guard = agent->command_guard;
   const bool fresh = guard.haveAccepted() &&
-                     std::abs((now - guard.lastStamp()).toSec()) <= options_.command_timeout;
+                     std::abs(1e-9 * static_cast<double>(nanosecondsOf(now) - guard.lastStamp())) <=
+                         options_.command_timeout;
   if (fresh) {
     if (agent->command_timed_out) {
       ROS_INFO_STREAM(name_ << ": " << agent->name << "/command fresh again");
@@ -427,7 +445,8 @@ GenericDimensions::InputVector PlantNode::commandAt(Agent* agent, const ros::Tim
     return agent->command;
   }
   if (guard.haveAccepted() && !agent->command_timed_out) {
-    ROS_WARN_STREAM(name_ << ": " << agent->name << "/command stamped " << guard.lastStamp().toSec()
+    ROS_WARN_STREAM(name_ << ": " << agent->name << "/command stamped "
+                          << 1e-9 * static_cast<double>(guard.lastStamp())
                           << " s is older than ~command_timeout (" << options_.command_timeout
                           << " s) at " << now.toSec() << " s: using zero");
     agent->command_timed_out = true;

@@ -1,9 +1,11 @@
 #include "projection_collision_avoidance/ros/RosParameters.hpp"
 
 #include <algorithm>
+#include <cstddef>
 #include <sstream>
 
 #include <ros/console.h>
+#include <ros/init.h>
 
 #include "projection_collision_avoidance/ParameterError.hpp"
 #include "projection_collision_avoidance/ScenarioLoader.hpp"
@@ -41,12 +43,34 @@ std::string typeName(const XmlRpc::XmlRpcValue& value) {
   }
 }
 
-/// toYaml() below @p path (a dotted path, "" for the root). A string becomes a scalar tagged as
-/// a string, so that "0.2" or "true" is not taken for a number or a boolean; binary data and
-/// dates have no place in a scenario and are refused with their path.
-// NOLINTNEXTLINE(misc-no-recursion): bounded by the depth of the parameter tree
-YAML::Node toYamlAt(const XmlRpc::XmlRpcValue& value, const std::string& path) {
+/// Nodes converted so far by one toYaml(), against kMaxScenarioNodes.
+struct Conversion {
+  std::size_t nodes = 0;
+};
+
+std::string below(const std::string& path, const std::string& element) {
+  return path.empty() ? element : path + "." + element;
+}
+
+/// toYaml() of @p value at @p path (a dotted path, "" for the root) and @p depth (the lists and
+/// maps it lies in). A string becomes a scalar tagged as a string, so that "0.2" or "true" is
+/// not taken for a number or a boolean; binary data and dates have no place in a scenario and
+/// are refused with their path. The limits of the scenario files apply: a list or map deeper
+/// than kMaxScenarioDepth, or more than kMaxScenarioNodes nodes, is refused with its path.
+// NOLINTNEXTLINE(misc-no-recursion): bounded by kMaxScenarioDepth
+YAML::Node toYamlAt(const XmlRpc::XmlRpcValue& value, const std::string& path, std::size_t depth,
+                    Conversion* conversion) {
   XmlRpc::XmlRpcValue& v = const_cast<XmlRpc::XmlRpcValue&>(value);  // XmlRpc lacks const access
+  if (++conversion->nodes > kMaxScenarioNodes) {
+    throw ParameterError(path, "over the node limit of a scenario (" +
+                                   std::to_string(kMaxScenarioNodes) + " nodes)");
+  }
+  const bool collection = v.getType() == XmlRpc::XmlRpcValue::TypeArray ||
+                          v.getType() == XmlRpc::XmlRpcValue::TypeStruct;
+  if (collection && depth > kMaxScenarioDepth) {
+    throw ParameterError(path, "nested deeper than the depth limit of a scenario (" +
+                                   std::to_string(kMaxScenarioDepth) + " lists and maps)");
+  }
   switch (v.getType()) {
     case XmlRpc::XmlRpcValue::TypeBoolean:
       return YAML::Node(static_cast<bool>(v));
@@ -62,14 +86,15 @@ YAML::Node toYamlAt(const XmlRpc::XmlRpcValue& value, const std::string& path) {
     case XmlRpc::XmlRpcValue::TypeArray: {
       YAML::Node sequence(YAML::NodeType::Sequence);
       for (int i = 0; i < v.size(); ++i) {
-        sequence.push_back(toYamlAt(v[i], (path.empty() ? "" : path + ".") + std::to_string(i)));
+        sequence.push_back(toYamlAt(v[i], below(path, std::to_string(i)), depth + 1, conversion));
       }
       return sequence;
     }
     case XmlRpc::XmlRpcValue::TypeStruct: {
       YAML::Node map(YAML::NodeType::Map);
       for (auto& entry : v) {
-        map[entry.first] = toYamlAt(entry.second, (path.empty() ? "" : path + ".") + entry.first);
+        conversion->nodes += 1;  // the key
+        map[entry.first] = toYamlAt(entry.second, below(path, entry.first), depth + 1, conversion);
       }
       return map;
     }
@@ -79,11 +104,13 @@ YAML::Node toYamlAt(const XmlRpc::XmlRpcValue& value, const std::string& path) {
   }
 }
 
-}  // namespace
+/// True once the node is shutting down (SIGINT, rosnode kill, ros::shutdown()): ends a scenario
+/// load that is still parsing. Before ros::spin() too: roscpp's poll thread turns the SIGINT
+/// into ros::shutdown(), which clears ros::ok().
+bool shuttingDown() { return !ros::ok() || ros::isShuttingDown(); }
 
-YAML::Node toYaml(const XmlRpc::XmlRpcValue& value) { return toYamlAt(value, ""); }
-
-Scenario loadScenarioParameter(const ros::NodeHandle& private_nh, const std::string& name) {
+Scenario loadScenarioAt(const ros::NodeHandle& private_nh, const std::string& name,
+                        const ScenarioLoadOptions& options) {
   XmlRpc::XmlRpcValue value;
   if (!private_nh.getParam(name, value)) {
     throw ParameterError("~" + name,
@@ -93,21 +120,35 @@ Scenario loadScenarioParameter(const ros::NodeHandle& private_nh, const std::str
   }
   try {
     if (value.getType() == XmlRpc::XmlRpcValue::TypeString) {
-      return loadScenarioFile(static_cast<std::string>(value));
+      return loadScenarioFile(static_cast<std::string>(value), {}, options);
     }
     if (value.getType() != XmlRpc::XmlRpcValue::TypeStruct) {
       throw ParameterError("", "must be a map or a file path, got " + typeName(value));
     }
-    return scenarioFromYaml(toYaml(value));
+    return scenarioFromYaml(toYaml(value), {}, options);
   } catch (const ParameterError& error) {
     throw ParameterError(parameterName(name, error.key()), error.reason());
+  } catch (const ScenarioLoadCancelled& cancelled) {
+    throw ScenarioLoadCancelled("~" + name + ": " + cancelled.what());
   }
 }
 
-Scenario loadDoubleIntegratorScenario(const ros::NodeHandle& private_nh, const std::string& name) {
-  Scenario scenario = loadScenarioParameter(private_nh, name);
+}  // namespace
+
+YAML::Node toYaml(const XmlRpc::XmlRpcValue& value) {
+  Conversion conversion;
+  return toYamlAt(value, "", 1, &conversion);
+}
+
+Scenario loadScenarioParameter(const ros::NodeHandle& private_nh, const std::string& name) {
+  ScenarioLoadOptions options;
+  options.cancelled = shuttingDown;
+  return loadScenarioAt(private_nh, name, options);
+}
+
+void requireNodeScenario(const Scenario& scenario) {
   if (!scenario.controller.model.isDoubleIntegrator()) {
-    throw ParameterError("~" + name + "/model/type",
+    throw ParameterError("model.type",
                          "the ROS nodes run double_integrator models (relative position and "
                          "velocity); use cf_sim for a linear model");
   }
@@ -116,9 +157,15 @@ Scenario loadDoubleIntegratorScenario(const ros::NodeHandle& private_nh, const s
     std::ostringstream reason;
     reason << "the ROS nodes run at " << kMinNodeRate << " to " << kMaxNodeRate << " Hz, got "
            << rate << "; use cf_sim for other rates";
-    throw ParameterError("~" + name + "/controller/control_rate", reason.str());
+    throw ParameterError("controller.control_rate", reason.str());
   }
-  return scenario;
+}
+
+Scenario loadDoubleIntegratorScenario(const ros::NodeHandle& private_nh, const std::string& name) {
+  ScenarioLoadOptions options;
+  options.cancelled = shuttingDown;
+  options.check = requireNodeScenario;
+  return loadScenarioAt(private_nh, name, options);
 }
 
 bool NodeOptionReader::lookup(const std::string& key, XmlRpc::XmlRpcValue* value) const {

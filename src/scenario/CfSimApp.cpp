@@ -261,6 +261,12 @@ int runCfSim(const std::vector<std::string>& arguments, std::ostream& out, std::
   }
   try {
     const Scenario scenario = loadScenarioFile(options.scenario_path, options.overrides);
+    if (options.continuous_step > 0.0 && std::isfinite(scenario.controller.jerk_limit)) {
+      err << "cf_sim: --continuous runs the continuous-time law, which has no control period: "
+             "controller.jerk_limit is not supported there (remove it, or run without "
+             "--continuous)\n";
+      return 2;
+    }
     if (!options.sweep_path.empty()) {
       return runSweep(scenario, options, out, err);
     }

@@ -3,8 +3,6 @@
 #include <cmath>
 #include <cstddef>
 #include <exception>
-#include <filesystem>
-#include <fstream>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -191,6 +189,9 @@ ControllerParameters readController(detail::YamlReader& reader, const AgentModel
   if (controller.has("acceleration_limit")) {
     result.acceleration_limit = controller.number("acceleration_limit");
   }
+  if (controller.has("jerk_limit")) {
+    result.jerk_limit = controller.number("jerk_limit");
+  }
   if (controller.has("fallback")) {
     detail::YamlReader fallback = controller.map("fallback");
     if (fallback.has("gain") && fallback.has("velocity_gain")) {
@@ -285,7 +286,8 @@ SignalProfile readInputProfile(detail::YamlReader& leader, Eigen::Index size) {
   return profile;
 }
 
-Scenario readScenario(const YAML::Node& root) {
+/// Reads every key, runs the per-key checks, then @p check, then the design's derived checks.
+Scenario readScenario(const YAML::Node& root, const ScenarioLoadOptions& options) {
   detail::YamlReader reader(root, "");
   Scenario scenario;
   const AgentModel model = readModel(reader);
@@ -326,12 +328,16 @@ Scenario readScenario(const YAML::Node& root) {
   }
   reader.finish();
 
-  ControllerDesign::create(scenario.controller);
   scenario.validate();
+  if (options.check) {
+    options.check(scenario);
+  }
+  ControllerDesign::create(scenario.controller);
   return scenario;
 }
 
-Scenario parseRoot(YAML::Node root, const std::vector<std::string>& overrides) {
+Scenario parseRoot(YAML::Node root, const std::vector<std::string>& overrides,
+                   const ScenarioLoadOptions& options) {
   if (!root.IsMap()) {
     throw ParameterError("(root)", "a scenario is a YAML map");
   }
@@ -339,7 +345,7 @@ Scenario parseRoot(YAML::Node root, const std::vector<std::string>& overrides) {
     for (const std::string& assignment : overrides) {
       applyOverride(root, assignment);
     }
-    return readScenario(root);
+    return readScenario(root, options);
   } catch (const YAML::Exception& error) {  // every read names its key; this is a safety net
     throw ParameterError("(root)", std::string("cannot be read: ") + error.what());
   }
@@ -347,26 +353,19 @@ Scenario parseRoot(YAML::Node root, const std::vector<std::string>& overrides) {
 
 }  // namespace
 
-Scenario scenarioFromYaml(const YAML::Node& root, const std::vector<std::string>& overrides) {
-  return parseRoot(YAML::Clone(root), overrides);
+Scenario scenarioFromYaml(const YAML::Node& root, const std::vector<std::string>& overrides,
+                          const ScenarioLoadOptions& options) {
+  return parseRoot(YAML::Clone(root), overrides, options);
 }
 
-Scenario parseScenario(const std::string& yaml_text, const std::vector<std::string>& overrides) {
-  return parseRoot(detail::parseYaml(yaml_text), overrides);
+Scenario parseScenario(const std::string& yaml_text, const std::vector<std::string>& overrides,
+                       const ScenarioLoadOptions& options) {
+  return parseRoot(detail::parseYaml(yaml_text, options.cancelled), overrides, options);
 }
 
-Scenario loadScenarioFile(const std::string& path, const std::vector<std::string>& overrides) {
-  std::error_code ignored;
-  if (std::filesystem::is_directory(path, ignored)) {
-    throw ParameterError("(file)", "'" + path + "' is a directory, not a scenario file");
-  }
-  std::ifstream file(path);
-  if (!file) {
-    throw ParameterError("(file)", "cannot read '" + path + "'");
-  }
-  std::stringstream text;
-  text << file.rdbuf();
-  return parseScenario(text.str(), overrides);
+Scenario loadScenarioFile(const std::string& path, const std::vector<std::string>& overrides,
+                          const ScenarioLoadOptions& options) {
+  return parseScenario(detail::readYamlFile(path), overrides, options);
 }
 
 }  // namespace projection_collision_avoidance

@@ -114,6 +114,30 @@ TEST(CfSim, ChoosesTheContinuousMethod) {
   EXPECT_NE(unknown.err.find("rk4 or rk6"), std::string::npos) << unknown.err;
 }
 
+// The sampled run honours controller.jerk_limit; the continuous-time law has no period to
+// limit the change over and refuses it, naming the key, rather than ignoring it.
+TEST(CfSim, JerkLimitInSampledRunsRefusedInContinuousOnes) {
+  const std::string scenario = scenarioPath("paper_run2.yaml");
+  const Result free_run = runApp({scenario});
+  const Result limited = runApp({scenario, "--set", "controller.jerk_limit=10"});
+  ASSERT_EQ(free_run.code, 0) << free_run.err;
+  ASSERT_EQ(limited.code, 0) << limited.err;
+  const auto free_values = parseSummary(free_run.out);
+  const auto limited_values = parseSummary(limited.out);
+  // The slower command lets the disturbance push further, still inside the bound.
+  EXPECT_GT(limited_values.at("max_xi"), free_values.at("max_xi"));
+  EXPECT_LT(limited_values.at("min_separation"), free_values.at("min_separation"));
+  EXPECT_LT(limited_values.at("max_xi"), limited_values.at("xi_max"));
+  const Result continuous =
+      runApp({scenario, "--set", "controller.jerk_limit=2", "--continuous", "0.01"});
+  EXPECT_EQ(continuous.code, 2);
+  EXPECT_NE(continuous.err.find("controller.jerk_limit"), std::string::npos) << continuous.err;
+  EXPECT_TRUE(continuous.out.empty());
+  const Result no_limit =
+      runApp({scenario, "--set", "controller.jerk_limit=.inf", "--continuous", "0.01"});
+  EXPECT_EQ(no_limit.code, 0) << no_limit.err;
+}
+
 TEST(CfSim, UsageErrorsExitWithTwo) {
   EXPECT_EQ(runApp({}).code, 2);
   EXPECT_EQ(runApp({scenarioPath("paper_run2.yaml"), "--set"}).code, 2);

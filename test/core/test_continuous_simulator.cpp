@@ -173,5 +173,20 @@ TEST(ContinuousSimulator, RefusesBadStepsAndFormations) {
   }
 }
 
+// The rate limit bounds the change per control period; the continuous law has none.
+TEST(ContinuousSimulator, RefusesAJerkLimit) {
+  Scenario scenario = loadScenarioFile(scenarioPath("paper_run2.yaml"));
+  scenario.controller.jerk_limit = 10.0;
+  try {
+    simulateContinuous(scenario, 0.01);
+    ADD_FAILURE() << "a jerk limit accepted";
+  } catch (const ParameterError& error) {
+    EXPECT_EQ(error.key(), "controller.jerk_limit");
+  }
+  EXPECT_THROW(
+      (void)ContinuousClosedLoop<DoubleIntegrator1D>(ControllerDesign::create(scenario.controller)),
+      ParameterError);
+}
+
 }  // namespace
 }  // namespace projection_collision_avoidance

@@ -1,6 +1,7 @@
 /// A control step allocates no memory (counted by test/common/AllocationCounter.cpp).
 
 #include <cstddef>
+#include <limits>
 #include <vector>
 
 #include <Eigen/Core>
@@ -21,32 +22,45 @@ namespace {
 
 /// Runs @p steps control steps (each with and without the leader's input, and as many fallback
 /// steps) on measurements inside and far outside the bound (so both the plain and the projected
-/// drift run) and returns the allocations counted during them.
+/// drift run) and returns the allocations counted during them. @p rate_limited counts the steps
+/// whose command the rate limit changed (may be null).
 template <typename Dims>
-long allocationsDuringSteps(const ControllerDesign& design, int steps) {
+long allocationsDuringSteps(const ControllerDesign& design, int steps,
+                            int* rate_limited = nullptr) {
   FollowerController<Dims> controller(design);
   typename Dims::OutputVector y(design.parameters.model.outputDimension());
   typename Dims::InputVector u1(design.parameters.model.inputDimension());
   u1.setConstant(0.3);
   const long before = testing::allocationCount();
   double sink = 0.0;
+  int limited = 0;
   for (int k = 0; k < steps; ++k) {
     y.setConstant((k / 50) % 2 == 0 ? 0.2 : 7.0);
     sink += controller.step(y).command(0);
+    limited += controller.status().command_rate_limited ? 1 : 0;
     sink += controller.step(y, u1).command(0);
+    limited += controller.status().command_rate_limited ? 1 : 0;
     sink += controller.stepFallback().command(0);
+    limited += controller.status().command_rate_limited ? 1 : 0;
     sink += controller.stepFallback(u1).command(0);
+    limited += controller.status().command_rate_limited ? 1 : 0;
   }
   const long after = testing::allocationCount();
   EXPECT_TRUE(std::isfinite(sink));
+  if (rate_limited != nullptr) {
+    *rate_limited = limited;
+  }
   return after - before;
 }
 
-ControllerDesign designFor(int axes, bool share) {
+/// The paper's Run 2 controller in @p axes axes; @p jerk_limit in m/s^3 (infinity: none).
+ControllerDesign designFor(int axes, bool share,
+                           double jerk_limit = std::numeric_limits<double>::infinity()) {
   Scenario scenario = loadScenarioFile(testing::scenarioPath("paper_run2.yaml"));
   scenario.controller.estimator_substeps = 3;
   scenario.controller.leader_input_in_command = share;
   scenario.controller.leader_input_in_estimator = share;
+  scenario.controller.jerk_limit = jerk_limit;
   if (axes > 1) {
     scenario = embedAlongDirection(scenario, Eigen::VectorXd::Ones(axes));
   }
@@ -92,6 +106,37 @@ TEST(NoAllocation, ControlStepsOfTheRuntimeController) {
 
 TEST(NoAllocation, ControlStepsOfTheGenericController) {
   EXPECT_EQ(allocationsDuringSteps<GenericDimensions>(designFor(3, true), 1000), 0);
+}
+
+/// With the rate limit acting (5 m/s^3: 5 mm/s^2 per tick at 1 kHz) in tracking and fallback.
+TEST(NoAllocation, ControlStepsWithTheRateLimitActive) {
+  int limited_1d = 0;
+  int limited_3d = 0;
+  int limited_generic = 0;
+  EXPECT_EQ(allocationsDuringSteps<DoubleIntegrator1D>(designFor(1, true, 5.0), 1000, &limited_1d),
+            0);
+  EXPECT_EQ(allocationsDuringSteps<DoubleIntegrator3D>(designFor(3, true, 5.0), 1000, &limited_3d),
+            0);
+  EXPECT_EQ(
+      allocationsDuringSteps<GenericDimensions>(designFor(3, true, 5.0), 1000, &limited_generic),
+      0);
+  EXPECT_GT(limited_1d, 100);
+  EXPECT_GT(limited_3d, 100);
+  EXPECT_GT(limited_generic, 100);
+
+  RuntimeFollowerController runtime(designFor(2, true, 5.0));
+  Eigen::VectorXd y = Eigen::VectorXd::Constant(4, 0.2);
+  const Eigen::VectorXd u1 = Eigen::VectorXd::Constant(2, 0.3);
+  runtime.step(y);
+  int limited = 0;
+  const long before = testing::allocationCount();
+  for (int k = 0; k < 1000; ++k) {
+    y.setConstant((k / 50) % 2 == 0 ? 0.2 : 7.0);
+    limited += runtime.step(y, u1).command_rate_limited ? 1 : 0;
+    limited += runtime.stepFallback(u1).command_rate_limited ? 1 : 0;
+  }
+  EXPECT_EQ(testing::allocationCount() - before, 0);
+  EXPECT_GT(limited, 100);
 }
 
 TEST(NoAllocation, DisturbedAgentStepsAwayFromPulseEdges) {

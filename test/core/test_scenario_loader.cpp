@@ -1,9 +1,16 @@
-/// The YAML scenario loader: the paper's files, overrides, and every error naming its key.
+/// The YAML scenario loader: the paper's files, overrides, every error naming its key, the size
+/// limit of files, and the caller's checks running before the design's derived ones.
 
+#include <cstdint>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <string>
+#include <system_error>
+#include <vector>
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include "projection_collision_avoidance/ParameterError.hpp"
 #include "projection_collision_avoidance/ScenarioLoader.hpp"
@@ -271,6 +278,114 @@ TEST(ScenarioLoader, RefusesBadOverridesAndFiles) {
   }
   EXPECT_THROW(parseScenario("model: [unclosed"), ParameterError);
   EXPECT_THROW(parseScenario("- a\n- b\n"), ParameterError);
+}
+
+/// A file in the temporary directory, named after this process, removed when the test ends.
+class ScratchFile {
+ public:
+  explicit ScratchFile(const std::string& name)
+      : path_(std::filesystem::temp_directory_path() /
+              ("test_scenario_loader_" + std::to_string(::getpid()) + "_" + name)) {}
+  ~ScratchFile() {
+    std::error_code ignored;
+    std::filesystem::remove(path_, ignored);
+  }
+  ScratchFile(const ScratchFile&) = delete;
+  ScratchFile& operator=(const ScratchFile&) = delete;
+  ScratchFile(ScratchFile&&) = delete;
+  ScratchFile& operator=(ScratchFile&&) = delete;
+
+  std::string path() const { return path_.string(); }
+  void write(const std::string& text) const { std::ofstream(path_, std::ios::binary) << text; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+/// The message of the ParameterError that loading @p path ends with (key "(file)").
+std::string fileRefusal(const std::string& path) {
+  try {
+    loadScenarioFile(path);
+  } catch (const ParameterError& error) {
+    EXPECT_EQ(error.key(), "(file)") << error.what();
+    return error.what();
+  }
+  ADD_FAILURE() << "accepted " << path;
+  return "";
+}
+
+TEST(ScenarioLoaderLimits, RefusesAFileOverTheSizeLimit) {
+  // The paper's scenario padded with a comment to the limit is read; one byte more is not.
+  ScratchFile file("padded.yaml");
+  std::string text = paperText() + "#";
+  text.resize(kMaxScenarioBytes, 'x');
+  file.write(text);
+  EXPECT_DOUBLE_EQ(loadScenarioFile(file.path()).controller.alpha, 0.2);
+  file.write(text + "x");
+  std::string message = fileRefusal(file.path());
+  EXPECT_NE(message.find("'" + file.path() + "' has " + std::to_string(kMaxScenarioBytes + 1) +
+                         " bytes, over the size limit of a scenario (" +
+                         std::to_string(kMaxScenarioBytes) + " bytes)"),
+            std::string::npos)
+      << message;
+}
+
+TEST(ScenarioLoaderLimits, RefusesALargeFileByItsSizeBeforeReadingIt) {
+  // 16 GiB, sparse: read, it would take that much memory.
+  ScratchFile file("sparse.yaml");
+  file.write("a: 1\n");
+  const std::uintmax_t size = std::uintmax_t{1} << 34U;
+  std::error_code error;
+  std::filesystem::resize_file(file.path(), size, error);
+  if (error) {
+    GTEST_SKIP() << "cannot make a sparse file here: " << error.message();
+  }
+  const std::string message = fileRefusal(file.path());
+  EXPECT_NE(message.find("has " + std::to_string(size) + " bytes"), std::string::npos) << message;
+  EXPECT_NE(message.find("size limit"), std::string::npos) << message;
+}
+
+TEST(ScenarioLoaderLimits, StopsReadingAFileOfUnknownSizeAtTheLimit) {
+  // A device without end: refused once one byte more than the limit has been read.
+  if (!std::filesystem::exists("/dev/zero")) {
+    GTEST_SKIP() << "no /dev/zero";
+  }
+  const std::string message = fileRefusal("/dev/zero");
+  EXPECT_NE(message.find("has more than " + std::to_string(kMaxScenarioBytes) + " bytes"),
+            std::string::npos)
+      << message;
+}
+
+TEST(ScenarioLoader, RunsTheCallersCheckBeforeTheDesignsDerivedChecks) {
+  // At 0.999 Hz one RK4 substep of the estimator is unstable: the design alone names substeps.
+  const std::vector<std::string> slow = {"controller.control_rate=0.999"};
+  expectKey(slow, "controller.estimator.substeps", "RK4");
+  // A caller that refuses rates below 1 Hz has the rate named instead.
+  ScenarioLoadOptions options;
+  options.check = [](const Scenario& scenario) {
+    if (scenario.controller.control_rate < 1.0) {
+      throw ParameterError("controller.control_rate", "below 1 Hz");
+    }
+  };
+  try {
+    parseScenario(paperText(), slow, options);
+    ADD_FAILURE() << "accepted a rate of 0.999 Hz";
+  } catch (const ParameterError& error) {
+    EXPECT_EQ(error.key(), "controller.control_rate") << error.what();
+  }
+  // The loader's own per-key checks come first: the check sees only values that passed them,
+  // and runs once on a valid scenario.
+  int checks = 0;
+  options.check = [&checks](const Scenario&) { ++checks; };
+  try {
+    parseScenario(paperText(), {"simulation.duration=-1"}, options);
+    ADD_FAILURE() << "accepted a negative duration";
+  } catch (const ParameterError& error) {
+    EXPECT_EQ(error.key(), "simulation.duration") << error.what();
+  }
+  EXPECT_EQ(checks, 0);
+  parseScenario(paperText(), {}, options);
+  EXPECT_EQ(checks, 1);
 }
 
 }  // namespace

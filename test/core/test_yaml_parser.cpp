@@ -1,6 +1,8 @@
 /// The libyaml front end of the scenario loader: the trees it builds are those of yaml-cpp's own
-/// YAML::Load(), node for node and tag for tag, and what it refuses names "(file)".
+/// YAML::Load(), node for node and tag for tag, and what it refuses names "(file)". Its limits
+/// (size, depth, nodes with aliases expanded) and its cancellation.
 
+#include <cstddef>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -19,6 +21,7 @@
 namespace projection_collision_avoidance {
 namespace {
 
+using detail::kCancelPollEvents;
 using detail::parseYaml;
 
 /// Empty when the trees are equal (type, tag, scalar text, sizes, keys in order), else where
@@ -137,6 +140,150 @@ TEST(YamlParser, TheScenarioLoaderRefusesADuplicatedKeyAndABadOverride) {
     EXPECT_EQ(error.key(), "controller.alpha") << error.what();
     EXPECT_NE(std::string(error.what()).find("not valid YAML"), std::string::npos) << error.what();
   }
+}
+
+/// The message of the ParameterError that parsing @p text ends with ("" and a failure if none).
+std::string refusal(const std::string& text) {
+  try {
+    parseYaml(text);
+  } catch (const ParameterError& error) {
+    EXPECT_EQ(error.key(), "(file)") << error.what();
+    return error.what();
+  }
+  ADD_FAILURE() << "accepted " << text.substr(0, 80) << "...";
+  return "";
+}
+
+bool contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+/// @p depth flow lists nested in one another: "[[[]]]".
+std::string nestedLists(std::size_t depth) {
+  return std::string(depth, '[') + std::string(depth, ']');
+}
+
+/// A flow list of @p items plain scalars: items + 1 nodes on line 1, item i at column 2 + 2 i.
+std::string flatList(std::size_t items) {
+  std::string text = "[";
+  for (std::size_t i = 0; i < items; ++i) {
+    text += i == 0 ? "1" : ",1";
+  }
+  return text + "]";
+}
+
+TEST(YamlParserLimits, RefusesTextOverTheSizeLimit) {
+  std::string text = "a: 1\n#";  // a comment pads the document to the limit
+  text.resize(kMaxScenarioBytes, 'x');
+  EXPECT_EQ(parseYaml(text)["a"].as<int>(), 1);
+  text += 'x';
+  const std::string message = refusal(text);
+  EXPECT_TRUE(contains(message, "size limit")) << message;
+  EXPECT_TRUE(contains(message, "(" + std::to_string(kMaxScenarioBytes) + " bytes)")) << message;
+  EXPECT_TRUE(contains(message, "has " + std::to_string(text.size()) + " bytes")) << message;
+}
+
+TEST(YamlParserLimits, RefusesNestingOverTheDepthLimit) {
+  EXPECT_TRUE(parseYaml(nestedLists(kMaxScenarioDepth)).IsSequence());
+  std::string message = refusal(nestedLists(kMaxScenarioDepth + 1));
+  EXPECT_TRUE(contains(message, "depth limit")) << message;
+  EXPECT_TRUE(contains(message, "(" + std::to_string(kMaxScenarioDepth) + " lists and maps)"))
+      << message;
+  EXPECT_TRUE(contains(message, "line 1, column " + std::to_string(kMaxScenarioDepth + 1)))
+      << message;
+  // Block maps count as lists do (the root map and controller's are two levels); the message
+  // gives the path to the entry.
+  message = refusal("controller:\n  extra: " + nestedLists(kMaxScenarioDepth - 1) + "\n");
+  EXPECT_TRUE(contains(message, "line 2, column " + std::to_string(kMaxScenarioDepth + 8)))
+      << message;
+  EXPECT_TRUE(contains(message, "in controller.extra.0.0")) << message;
+  // A file of nothing but opening brackets is refused at the limit, not read to its end.
+  message = refusal(std::string(kMaxScenarioBytes, '['));
+  EXPECT_TRUE(contains(message, "depth limit")) << message;
+}
+
+TEST(YamlParserLimits, RefusesTreesOverTheNodeLimit) {
+  EXPECT_EQ(parseYaml(flatList(kMaxScenarioNodes - 1)).size(), kMaxScenarioNodes - 1);
+  const std::string message = refusal(flatList(kMaxScenarioNodes));
+  EXPECT_TRUE(contains(message, "node limit")) << message;
+  EXPECT_TRUE(contains(message, "(" + std::to_string(kMaxScenarioNodes) + " nodes")) << message;
+  EXPECT_TRUE(contains(message, "line 1, column " + std::to_string(2 * kMaxScenarioNodes)))
+      << message;
+  EXPECT_TRUE(contains(message, "in " + std::to_string(kMaxScenarioNodes - 1))) << message;
+}
+
+TEST(YamlParserLimits, CountsAnAliasAsTheNodesItRepeats) {
+  // a: 1000 nodes; b: k aliases of a. In all 1 (root) + 1 + 1000 + 1 + 1 + 1000 k nodes.
+  const std::string anchor = "a: &a " + flatList(999) + "\n";
+  const std::size_t most = (kMaxScenarioNodes - 1004) / 1000;
+  const auto aliases = [&](std::size_t k) {
+    std::string text = anchor + "b: [";
+    for (std::size_t i = 0; i < k; ++i) {
+      text += i == 0 ? "*a" : ", *a";
+    }
+    return text + "]\n";
+  };
+  EXPECT_EQ(parseYaml(aliases(most))["b"].size(), most);
+  const std::string message = refusal(aliases(most + 1));
+  EXPECT_TRUE(contains(message, "node limit")) << message;
+  EXPECT_TRUE(contains(message, "in b." + std::to_string(most))) << message;
+}
+
+TEST(YamlParserLimits, RefusesAnAliasBomb) {
+  // Line i + 1 holds l<i>: ten aliases of l<i-1>, 10^10 nodes expanded by l9. It is refused
+  // on the first line that takes the expanded count over the limit.
+  std::string text = "l0: &l0 [x, x, x, x, x, x, x, x, x, x]\n";
+  std::size_t size = 11;           // nodes of l<i>
+  std::size_t total = 1 + 1 + 11;  // the root map, the key l0 and l0
+  std::size_t refused_line = 0;
+  for (int i = 1; i <= 9; ++i) {
+    const std::string previous = "*l" + std::to_string(i - 1);
+    text += "l" + std::to_string(i) + ": &l" + std::to_string(i) + " [" + previous;
+    for (int k = 1; k < 10; ++k) {
+      text += ", " + previous;
+    }
+    text += "]\n";
+    size = 1 + 10 * size;
+    total += 1 + size;
+    if (refused_line == 0 && total > kMaxScenarioNodes) {
+      refused_line = static_cast<std::size_t>(i) + 1;
+    }
+  }
+  ASSERT_NE(refused_line, 0U);
+  const std::string message = refusal(text);
+  EXPECT_TRUE(contains(message, "node limit")) << message;
+  EXPECT_TRUE(contains(message, "line " + std::to_string(refused_line) + ",")) << message;
+  // An alias inside the collection it names would repeat without end.
+  EXPECT_TRUE(contains(refusal("a: &a [1, *a]\n"), "lies inside the collection it repeats"));
+}
+
+TEST(YamlParserLimits, StopsWhenCancelled) {
+  const std::size_t items = 10 * kCancelPollEvents;
+  const std::string text = flatList(items);
+  std::size_t polls = 0;
+  const auto never = [&polls] {
+    ++polls;
+    return false;
+  };
+  EXPECT_EQ(parseYaml(text, never).size(), items);
+  EXPECT_GE(polls, items / kCancelPollEvents);  // one event per item, and a few more
+  polls = 0;
+  const auto third = [&polls] { return ++polls == 3; };
+  try {
+    parseYaml(text, third);
+    ADD_FAILURE() << "not cancelled";
+  } catch (const ScenarioLoadCancelled& error) {
+    EXPECT_EQ(polls, 3U);
+    EXPECT_TRUE(contains(error.what(), "loading cancelled at line 1, column ")) << error.what();
+  }
+  // Before the first event, and through the loader as the same exception (not a ParameterError).
+  EXPECT_THROW(parseYaml("a: 1\n", [] { return true; }), ScenarioLoadCancelled);
+  ScenarioLoadOptions options;
+  options.cancelled = [] { return true; };
+  EXPECT_THROW(loadScenarioFile(testing::scenarioPath("paper_run2.yaml"), {}, options),
+               ScenarioLoadCancelled);
+  options.cancelled = [] { return false; };
+  EXPECT_NO_THROW(loadScenarioFile(testing::scenarioPath("paper_run2.yaml"), {}, options));
 }
 
 }  // namespace

@@ -185,7 +185,11 @@ def launch_uses(root, path):
     """The nodes and tests of one launch or test file from other packages, and their prefixes."""
     test_only = is_test_path(root, path)
     where = str(path.relative_to(root))
-    for element in ET.parse(path).getroot().iter():
+    try:
+        root_element = ET.parse(path).getroot()
+    except ET.ParseError as error:
+        raise SystemExit(f"check_dependencies: {path}: {error}") from error
+    for element in root_element.iter():
         if element.tag not in ("node", "test"):
             continue
         pkgs = choices(element.get("pkg", ""))

@@ -2,7 +2,10 @@
 /// and its dynamic_reconfigure interface, on the paper's Run 2. Parameters of the test node:
 ///   ~wall_deadline  wall seconds to wait for each condition
 
+#include <cmath>
+#include <limits>
 #include <set>
+#include <string>
 
 #include <dynamic_reconfigure/Reconfigure.h>
 #include <gtest/gtest.h>
@@ -69,6 +72,8 @@ TEST_F(FollowerTest, PublishesStatusWithTheScenariosBounds) {
               1e-12);
   EXPECT_TRUE(s.tracker_enabled);
   EXPECT_FALSE(s.command_saturated);
+  EXPECT_FALSE(s.command_rate_limited);
+  EXPECT_TRUE(std::isinf(s.jerk_limit));
   EXPECT_NEAR(s.separation, 5.0, 0.05);  // before the disturbance the follower holds its slot
 }
 
@@ -145,6 +150,50 @@ TEST_F(FollowerTest, ReconfigureSwitchesTheTrackerAndRefusesAnInvalidAlpha) {
   const dynamic_reconfigure::Config accepted = reconfigure("alpha", 0.3, false, false);
   EXPECT_DOUBLE_EQ(doubleOf(accepted, "alpha"), 0.3);
   EXPECT_TRUE(waitFor([this] { return std::abs(record_.last.xi_max - 3.5) < 1e-12; }, deadline));
+}
+
+/// The tracker gain the follower's diagnostics report, "" before they do.
+std::string trackerGainOf(const diagnostic_msgs::DiagnosticStatus& status) {
+  for (const auto& value : status.values) {
+    if (value.key == "tracker_gain") {
+      return value.value;
+    }
+  }
+  return "";
+}
+
+TEST_F(FollowerTest, ReconfigureFrequencyZeroRestoresTheFilesGainAndNeverStoresNonFinite) {
+  const double deadline = param("wall_deadline");
+  const auto gain_is = [this](const std::string& gain) {  // called by waitFor() with mutex_ held
+    return !follower_diagnostics_.empty() && trackerGainOf(follower_diagnostics_.back()) == gain;
+  };
+  // Run 2's G_e = [10, 5]; (omega_n, zeta) = (2, 0.7) gives [omega_n^2, 2 zeta omega_n].
+  ASSERT_TRUE(waitFor([&] { return gain_is("[10, 5]"); }, deadline));
+  reconfigure("tracker_damping", 0.7, false, false);
+  const dynamic_reconfigure::Config set =
+      reconfigure("tracker_natural_frequency", 2.0, false, false);
+  EXPECT_DOUBLE_EQ(doubleOf(set, "tracker_natural_frequency"), 2.0);
+  EXPECT_TRUE(waitFor([&] { return gain_is("[4, 2.8]"); }, deadline));
+  const dynamic_reconfigure::Config restored =
+      reconfigure("tracker_natural_frequency", 0.0, false, false);
+  EXPECT_DOUBLE_EQ(doubleOf(restored, "tracker_natural_frequency"), 0.0);
+  EXPECT_TRUE(waitFor([&] { return gain_is("[10, 5]"); }, deadline));
+
+  // NaN is refused, whether or not the value would be used, and never stored; an infinity is
+  // clamped by dynamic_reconfigure to the range of cfg/Follower.cfg before the node sees it.
+  for (const char* name : {"alpha", "epsilon", "tracker_damping", "tracker_natural_frequency"}) {
+    // The configuration in force, from a call that changes nothing.
+    const double before = doubleOf(reconfigure("tracker_damping", 0.7, false, false), name);
+    const dynamic_reconfigure::Config refused = reconfigure(name, std::nan(""), false, false);
+    EXPECT_DOUBLE_EQ(doubleOf(refused, name), before) << name;
+    const dynamic_reconfigure::Config clamped =
+        reconfigure(name, std::numeric_limits<double>::infinity(), false, false);
+    EXPECT_TRUE(std::isfinite(doubleOf(clamped, name))) << name;
+  }
+  reconfigure("epsilon", 0.2, false, false);
+  reconfigure("tracker_damping", 0.7, false, false);
+  reconfigure("tracker_natural_frequency", 0.0, false, false);
+  EXPECT_TRUE(waitFor([&] { return gain_is("[10, 5]"); }, deadline));
 }
 
 }  // namespace

@@ -6,7 +6,8 @@ deadline, printing "invalid parameter <key>: <reason>" where <key> is the parame
 is running) fails the case at once.
 
 The cases are tables, one per class of invalid parameter (missing key, wrong type, out of range,
-non-Hurwitz gain, d not in ker(A), wrong size, unknown key, bad node option). Each case puts the
+non-Hurwitz gain, d not in ker(A), wrong size, unknown key, bad node option, scenario over a
+limit of size, depth or nodes, a value the nodes refuse that the design would name otherwise). Each case puts the
 paper's Run 2 scenario (spoiled) and its node options into a fresh private namespace on the one
 master of the test, then the nodes run there, several at a time. A positive test checks that
 whole numbers where the format expects reals (alpha: 0, control_rate: 100) are accepted."""
@@ -139,7 +140,32 @@ FILES = {
     "quoted_alpha.yaml": None,  # the paper's file with alpha: "0.2"
     "complex_key.yaml": None,  # the paper's file with a list as a key in controller
     "bad_dimension.yaml": None,  # the paper's file with dimension: 4
+    "too_large.yaml": None,  # the paper's file padded with a comment beyond the size limit
+    "too_deep.yaml": None,  # the paper's file with lists nested beyond the depth limit
+    "alias_bomb.yaml": None,  # the paper's file with aliases that expand beyond the node limit
+    "slow_rate.yaml": None,  # the paper's file with control_rate: 0.999
 }
+
+# The limits of scenario files (ScenarioLoader.hpp: kMaxScenarioBytes, kMaxScenarioDepth).
+MAX_BYTES = 1 << 20
+MAX_DEPTH = 64
+
+
+def nested_lists(depth):
+    """depth lists nested in one another around a 1: [[[1]]]."""
+    value = 1
+    for _ in range(depth):
+        value = [value]
+    return value
+
+
+def alias_bomb():
+    """YAML lines l0 .. l9, each ten aliases of the one before: 10^10 nodes once expanded."""
+    lines = ["l0: &l0 [x, x, x, x, x, x, x, x, x, x]"]
+    for i in range(1, 10):
+        lines.append(f"l{i}: &l{i} [" + ", ".join([f"*l{i - 1}"] * 10) + "]")
+    return "\n".join(lines) + "\n"
+
 
 MISSING_KEY = [
     case("~scenario not set", "~scenario", scenario=MISSING),
@@ -481,6 +507,36 @@ UNKNOWN_KEY = [
 ]
 
 
+# Each refusal names the limit (the message of the node is checked for it) and where.
+SIZE_LIMIT = [
+    case("~scenario file over the size limit", "~scenario", scenario="@too_large.yaml"),
+]
+DEPTH_LIMIT = [
+    case("~scenario file nested beyond the depth limit", "~scenario",
+         scenario="@too_deep.yaml"),
+    # From the parameter server: the innermost list beyond the limit, by its path (the
+    # scenario's map is the first level, extra's lists the next ones).
+    case("~scenario map nested beyond the depth limit",
+         "~scenario/extra" + "/0" * (MAX_DEPTH - 1), S("extra", nested_lists(MAX_DEPTH))),
+]
+NODE_LIMIT = [
+    case("~scenario file with an alias bomb", "~scenario", scenario="@alias_bomb.yaml"),
+]
+
+# Values the nodes refuse that the controller design would refuse too, naming another key: the
+# nodes' own check runs first and names the key as written.
+NODE_RANGE_FIRST = [
+    case("control_rate 0.999 (RK4 also unstable with one substep)",
+         "~scenario/controller/control_rate", S("controller.control_rate", 0.999)),
+    case("~scenario file: control_rate 0.999", "~scenario/controller/control_rate",
+         scenario="@slow_rate.yaml"),
+    case("model.type linear with a gain that does not stabilise it", "~scenario/model/type",
+         S("model", {"type": "linear", "A": [[0.0, 1.0], [0.0, 0.0]], "B": [[0.0], [1.0]],
+                     "position_dimension": 1},
+           "controller.baseline", {"gain": [[-1.0, 1.4]]})),
+]
+
+
 def opt(name, node, key, value):
     return case(name, "~" + key, options={key: value}, nodes=(node,))
 
@@ -615,6 +671,12 @@ class InvalidParameters(unittest.TestCase):
         contents["quoted_alpha.yaml"] = spoiled("alpha: 0.2", 'alpha: "0.2"')
         contents["complex_key.yaml"] = spoiled("controller:\n", "controller:\n  [1, 2]: 3\n")
         contents["bad_dimension.yaml"] = spoiled("dimension: 1", "dimension: 4")
+        contents["too_large.yaml"] = paper_text + "#" + "x" * MAX_BYTES + "\n"
+        contents["too_deep.yaml"] = spoiled(
+            "controller:\n", "controller:\n  extra: " + "[" * (2 * MAX_DEPTH) +
+            "]" * (2 * MAX_DEPTH) + "\n")
+        contents["alias_bomb.yaml"] = paper_text + alias_bomb()
+        contents["slow_rate.yaml"] = spoiled("control_rate: 1000.0", "control_rate: 0.999")
         for name, text in contents.items():
             with open(os.path.join(cls.directory, name), "w") as stream:
                 stream.write(text)
@@ -749,6 +811,15 @@ class InvalidParameters(unittest.TestCase):
 
     def test_bad_node_option(self):
         self.check_refused(NODE_OPTIONS)
+
+    def test_scenario_over_a_limit(self):
+        self.check_refused(SIZE_LIMIT, reasons=("over the size limit of a scenario",))
+        self.check_refused(DEPTH_LIMIT, reasons=("nested deeper than the depth limit",))
+        self.check_refused(NODE_LIMIT, reasons=("over the node limit of a scenario",))
+
+    def test_nodes_range_checks_before_the_design(self):
+        self.check_refused(NODE_RANGE_FIRST,
+                           reasons=("the ROS nodes run at", "the ROS nodes run double_integrator"))
 
     def test_thread_loop_refused_on_simulated_time(self):
         """~control_loop thread sleeps on the monotonic clock: with /use_sim_time true the

@@ -19,6 +19,7 @@
 #include "projection_collision_avoidance/RelativeMeasurement.h"
 #include "projection_collision_avoidance/RuntimeFollowerController.hpp"
 #include "projection_collision_avoidance/Scenario.hpp"
+#include "projection_collision_avoidance/ros/InputAdmission.hpp"
 #include "projection_collision_avoidance/ros/InputGuard.hpp"
 #include "projection_collision_avoidance/ros/RealtimeLoop.hpp"
 #include "projection_collision_avoidance/ros/RosParameters.hpp"
@@ -81,10 +82,17 @@ struct FollowerNodeOptions {
 /// `command` (geometry_msgs/AccelStamped), `broadcast` (LeaderBroadcast with that command as
 /// input and no state, for a follower behind it), `status` (FollowerStatus), `markers`
 /// (visualization_msgs/MarkerArray in the follower's frame, id = formation index) and
-/// diagnostics. Messages that are non-finite, of the wrong size, in the wrong frame, stamped in
-/// the future or before the last accepted one are refused and counted. dynamic_reconfigure
-/// changes the tracker switch, alpha, epsilon and the tracker gain; a set the controller design
-/// refuses is rejected and the old one kept.
+/// diagnostics. Messages that are non-finite, of the wrong size, in the wrong frame, stamped 0,
+/// in the future, stale on arrival, or not after the last accepted one are refused and counted
+/// (InputGuard), and so is a message whose judging throws: no input ends the node. When ROS time
+/// goes back (ClockWatch), the inputs of the old timeline are forgotten and the follower brakes
+/// until fresh measurements arrive. A tick that runs more than half ~measurement_timeout late
+/// (the process itself was stalled) is skipped, and so are the ticks after it until a
+/// measurement arrives or half ~measurement_timeout has passed (all counted as missed): the
+/// input sent while the process stood still decides the next step, not its absence.
+/// dynamic_reconfigure changes the tracker switch, alpha, epsilon and the tracker gain (frequency
+/// 0: the scenario file's gain); a set the controller design refuses, or with a non-finite value,
+/// is rejected and the old one kept.
 ///
 /// ~trigger decides what runs a control step. "timer" (default): a timer every 1 / control_rate s
 /// (ROS time), on the latest accepted measurement; the step is stamped with the timer's time, so
@@ -135,6 +143,10 @@ class FollowerNode {
   /// command, broadcast, status, markers, diagnostics. The one code path of both triggers.
   void controlStep(const ros::Time& stamp, double delay);
   void onReconfigure(FollowerConfig& config, uint32_t level);
+  /// Notes a jump back of ROS time at @p now, then judges @p header with @p guard (mutex_ held).
+  bool admitHeader(InputGuard& guard, const std_msgs::Header& header, const ros::Time& now);
+  /// ROS time went back to @p now (mutex_ held): forget the inputs of the old timeline.
+  void onTimeJump(const ros::Time& now);
   void publishStatus(const ros::Time& now, const Eigen::VectorXd& xi, double measurement_age);
   void publishMarkers(const ros::Time& now, const Eigen::VectorXd& xi);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
@@ -147,8 +159,9 @@ class FollowerNode {
   ros::NodeHandle private_nh_;
   NodeOptionReader reader_;  ///< the private options, read once
   FollowerNodeOptions options_;
-  FormationMember member_;           ///< this follower's place in the formation
-  ControllerParameters parameters_;  ///< as currently in force (scenario + reconfigure)
+  FormationMember member_;                ///< this follower's place in the formation
+  ControllerParameters file_parameters_;  ///< as the scenario gave them
+  ControllerParameters parameters_;       ///< as currently in force (scenario + reconfigure)
   RuntimeFollowerController controller_;
   int axes_;
 
@@ -157,6 +170,10 @@ class FollowerNode {
   InputGuard measurement_guard_;
   Eigen::VectorXd leader_input_;  ///< a_1 of the latest accepted leader broadcast
   InputGuard leader_guard_;
+  ClockWatch clock_;                     ///< jumps back of ROS time
+  bool resuming_ = false;                ///< a stall was seen; waiting for input (see controlTick)
+  ros::Time resumed_at_;                 ///< when the stall was seen
+  std::uint64_t accepted_at_stall_ = 0;  ///< measurements accepted when the stall was seen
   FollowerMode mode_ = FollowerMode::kWaiting;  ///< of the latest tick
   bool leader_fresh_ = false;                   ///< at the latest tick
   double last_xi_norm_ = 0.0;

@@ -1,49 +1,126 @@
 #pragma once
 
+#include <chrono>
+#include <cstdint>
 #include <string>
-
-#include <ros/time.h>
-#include <std_msgs/Header.h>
 
 namespace projection_collision_avoidance {
 
-/// Admission of the messages of one input topic: checks what a message header can get wrong
-/// (frame_id, a stamp in the future or before the last accepted one), counts every rejection
-/// and logs it once per change of reason (then at most every 5 s). Content checks (sizes,
-/// finiteness) are the caller's; it reports their failures through reject().
+/// Why an input message was refused. Logging is once per change of kind, so a kind must not
+/// depend on anything a sender controls (its frame_id, its numbers).
+enum class Rejection : std::uint8_t {
+  kFrame,        ///< frame_id other than the required one
+  kZeroStamp,    ///< stamp 0 (unset)
+  kFuture,       ///< stamped more than max_future_stamp ahead of the receiver's clock
+  kStale,        ///< older than max_age when it arrives
+  kOutOfOrder,   ///< stamped before the last accepted message
+  kRepeated,     ///< stamped exactly as the last accepted message
+  kContent,      ///< wrong size, non-finite entries, wrong child frame (the caller's checks)
+  kUnjudgeable,  ///< judging it failed (an exception while converting it)
+};
+
+/// "frame", "zero stamp", "future stamp", "stale", "out of order", "repeated stamp", "content",
+/// "unjudgeable".
+const char* toString(Rejection kind);
+
+/// What an input guard admits: the header checks of one input topic.
+struct InputGuardLimits {
+  std::string required_frame;   ///< frame_id a message must carry; "" accepts any
+  double max_future_stamp = 0;  ///< s a stamp may lie ahead of the receiver's clock (offsets)
+  double max_age = 0;           ///< s a message may be old when it arrives; <= 0: no limit
+};
+
+/// Admission of the messages of one input topic, free of ROS: stamps are ns since the epoch
+/// (`ros::Time::toNSec()`, which fits an int64 over the whole range of ros::Time), so no stamp
+/// can overflow the arithmetic. It refuses zero stamps, stamps too far ahead of the receiver's
+/// clock, messages stale on arrival, and stamps not after the last accepted one (a repeated stamp
+/// included); it counts every refusal, and says when a refusal is worth a log line: when its kind
+/// differs from the kind last logged (at most one such line per @ref kTransitionPeriod), and
+/// every @ref kSummaryPeriod while refusals go on; each line gives the count since the line
+/// before. Accepted messages in between do not make a refusal new. Texts a sender controls are
+/// cut to @ref kMaxQuotedLength characters.
+///
+/// Ages are measured from the *effective* stamp of a message, min(stamp, receipt time): a stamp
+/// ahead of the receiver's clock (within max_future_stamp) counts from its receipt, so an age is
+/// never negative while the clock runs forward. When the receiver's clock jumps back, call
+/// restartTimeline(): the inputs of the old timeline are forgotten (no age, so stale), while
+/// everAccepted() still tells that the input was heard.
 class InputGuard {
  public:
-  /// @param topic name used in log messages
-  /// @param required_frame frame_id a message must carry ("" accepts any)
-  /// @param max_future_stamp s by which a stamp may lie ahead of now (clock offsets)
-  InputGuard(std::string topic, std::string required_frame, double max_future_stamp);
+  /// Length to which a frame_id (or other text a sender controls) is cut when quoted (bytes).
+  static constexpr std::size_t kMaxQuotedLength = 64;
+  /// Length to which a reason is cut in logs and diagnostics (bytes).
+  static constexpr std::size_t kMaxReasonLength = 256;
+  /// Shortest interval between two log lines for a change of kind.
+  static constexpr std::chrono::seconds kTransitionPeriod{1};
+  /// Interval of the summary log line while refusals of the logged kind go on.
+  static constexpr std::chrono::seconds kSummaryPeriod{60};
+  using Clock = std::chrono::steady_clock;
 
-  /// Checks @p header against the frame, now + max_future_stamp and the last accepted stamp.
-  /// On failure counts and logs the rejection and returns false; the caller then drops the
-  /// message. On success the caller checks the content and calls accept() or reject().
-  bool checkHeader(const std_msgs::Header& header, const ros::Time& now);
+  InputGuard() = default;
+  /// @param topic the input's name in log lines
+  /// @param clock time source of the log intervals (a test's own, or the steady clock)
+  InputGuard(std::string topic, InputGuardLimits limits,
+             Clock::time_point (*clock)() = &Clock::now);
 
-  /// Counts and logs the rejection of a message for @p reason.
-  void reject(const std::string& reason);
+  /// Checks a header at the receiver's time @p now_ns: frame, zero stamp, future, stale, order.
+  /// Returns false after counting a refusal (see takeLogLine()); on true the caller checks the
+  /// content and calls accept() or reject().
+  bool checkHeader(const std::string& frame_id, std::int64_t stamp_ns, std::int64_t now_ns);
 
-  /// Records an accepted message stamped @p stamp; the next rejection is logged again.
-  void accept(const ros::Time& stamp);
+  /// Counts a refusal of @p kind; @p detail (cut to kMaxReasonLength) says what was wrong.
+  void reject(Rejection kind, const std::string& detail);
 
+  /// Records an accepted message stamped @p stamp_ns, received at @p now_ns.
+  void accept(std::int64_t stamp_ns, std::int64_t now_ns);
+
+  /// The receiver's clock went back: forget the last accepted stamp (the order check starts
+  /// afresh) and the age. Counts and everAccepted() are kept.
+  void restartTimeline();
+
+  /// A message was accepted on the current timeline.
   bool haveAccepted() const { return have_accepted_; }
-  const ros::Time& lastStamp() const { return last_stamp_; }
-  unsigned rejected() const { return rejected_; }
-  /// Reason of the latest rejection, "" once a message was accepted after it.
+  /// A message was accepted since start, on any timeline.
+  bool everAccepted() const { return ever_accepted_; }
+  /// Stamp of the last accepted message (ns), 0 before one.
+  std::int64_t lastStamp() const { return last_stamp_ns_; }
+  /// Age (s) at @p now_ns of the last accepted message, from its effective stamp; +infinity
+  /// when there is none on this timeline.
+  double ageAt(std::int64_t now_ns) const;
+
+  /// Messages accepted since start.
+  std::uint64_t accepted() const { return accepted_; }
+  /// Refusals since start.
+  std::uint64_t rejected() const { return rejected_; }
+  /// Refusals of the current kind since it began.
+  std::uint64_t rejectedOfKind() const { return run_length_; }
+  /// The latest refusal ("kind: detail", bounded), "" once a message was accepted after it.
   const std::string& lastRejection() const { return last_rejection_; }
+
+  /// The log line the latest refusal calls for, or "" (then nothing is due). Taking it clears it.
+  std::string takeLogLine();
 
  private:
   std::string topic_;
-  std::string required_frame_;
-  double max_future_stamp_;
+  InputGuardLimits limits_;
   bool have_accepted_ = false;
-  ros::Time last_stamp_;
-  unsigned rejected_ = 0;
+  bool ever_accepted_ = false;
+  std::int64_t last_stamp_ns_ = 0;
+  std::int64_t effective_stamp_ns_ = 0;
+  Clock::time_point (*clock_)() = &Clock::now;
+  std::uint64_t accepted_ = 0;
+  std::uint64_t rejected_ = 0;
+  Rejection kind_ = Rejection::kContent;  ///< kind of the latest refusal
+  std::uint64_t run_length_ = 0;          ///< refusals of kind_ in a row (accepts ignored)
+  bool have_logged_ = false;
+  Rejection logged_kind_ = Rejection::kContent;  ///< kind of the last log line
+  Clock::time_point last_log_;
+  std::uint64_t unlogged_ = 0;  ///< refusals since the last log line
   std::string last_rejection_;
-  std::string last_kind_;  ///< last_rejection_ without its numbers, for logging once per kind
+  std::string log_line_;
 };
+
+/// @p text cut to @p length characters, with the original length appended when cut.
+std::string boundedText(const std::string& text, std::size_t length);
 
 }  // namespace projection_collision_avoidance

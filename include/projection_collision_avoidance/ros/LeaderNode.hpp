@@ -8,6 +8,7 @@
 #include <ros/ros.h>
 
 #include "projection_collision_avoidance/Scenario.hpp"
+#include "projection_collision_avoidance/ros/InputAdmission.hpp"
 #include "projection_collision_avoidance/ros/InputGuard.hpp"
 
 namespace projection_collision_avoidance {
@@ -47,7 +48,7 @@ class LeaderNode {
   bool have_odometry_ = false;
   /// s by which an odometry stamp may lie ahead of the leader's clock
   static constexpr double kMaxFutureStamp = 0.1;
-  InputGuard odometry_guard_{"leader/odom", "", kMaxFutureStamp};
+  InputGuard odometry_guard_{"leader/odom", {"", kMaxFutureStamp, 0.0}};
   bool started_ = false;
   ros::Time origin_;      ///< ROS time of scenario time 0
   ros::Time last_stamp_;  ///< of the last tick published

@@ -14,6 +14,7 @@
 #include "projection_collision_avoidance/AgentIntegrator.hpp"
 #include "projection_collision_avoidance/RelativeMeasurement.h"
 #include "projection_collision_avoidance/Scenario.hpp"
+#include "projection_collision_avoidance/ros/InputAdmission.hpp"
 #include "projection_collision_avoidance/ros/InputGuard.hpp"
 #include "projection_collision_avoidance/ros/RosParameters.hpp"
 
@@ -97,6 +98,8 @@ class PlantNode {
   void onCommand(Agent* agent, const geometry_msgs::AccelStamped::ConstPtr& msg);
   void onWallTick(const ros::WallTimerEvent& event);
   void onRosTick(const ros::TimerEvent& event);
+  /// The body of onRosTick() (mutex_ held): the ticks due at ROS time now.
+  void rosTick();
   /// Samples, publishes and integrates tick k; false once the duration is reached (and then
   /// requests the shutdown).
   bool tick(long k);
@@ -120,6 +123,7 @@ class PlantNode {
   int axes_;
 
   std::mutex mutex_;  ///< guards everything below against concurrent callbacks (nodelets)
+  ClockWatch clock_;  ///< jumps back of ROS time (they restart the command guards' timelines)
   Agent leader_;
   std::vector<Follower> followers_;  ///< in index order; never resized after the subscriptions
   std::mt19937 rng_;

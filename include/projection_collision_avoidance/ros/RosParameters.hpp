@@ -23,19 +23,32 @@ constexpr double kMaxNodeRate = 10000.0;
 
 /// The same tree as YAML: structs become maps, arrays sequences, scalars scalars. A string
 /// becomes a scalar tagged as a string (like a quoted one), which the scenario loader does not
-/// take for a number or a boolean.
-/// @throws ParameterError (key: the entry's dotted path) for binary data or a date
+/// take for a number or a boolean. The limits of scenario files apply (kMaxScenarioDepth,
+/// kMaxScenarioNodes of ScenarioLoader.hpp; the root counts as depth 1, a key as a node).
+/// @throws ParameterError (key: the entry's dotted path) for binary data, a date, a list or map
+///         nested deeper than kMaxScenarioDepth, or the node beyond kMaxScenarioNodes
 YAML::Node toYaml(const XmlRpc::XmlRpcValue& value);
 
 /// Loads the scenario from the private parameter @p name: either a map (the scenario file loaded
 /// with `<rosparam command="load" file="..." ns="scenario"/>` inside the node) or a string, the
-/// path of a scenario file. Errors name "~<name>/<dotted/path>".
+/// path of a scenario file. Errors name "~<name>/<dotted/path>". Parsing a file stops once the
+/// node shuts down (SIGINT, also before ros::spin(), or ros::shutdown()).
+/// @throws ParameterError for an invalid scenario or one beyond the limits of scenario files
+/// @throws ScenarioLoadCancelled ("~<name>: loading cancelled at ...") when the node shut down
+///         while the file was parsed
 Scenario loadScenarioParameter(const ros::NodeHandle& private_nh,
                                const std::string& name = "scenario");
 
-/// As loadScenarioParameter(), refusing a model other than a double integrator (the ROS nodes
-/// exchange relative positions and velocities) with ParameterError("~<name>/model/type") and a
-/// control rate outside [kMinNodeRate, kMaxNodeRate] ("~<name>/controller/control_rate").
+/// The ROS nodes' own requirements of a scenario (ROS-free): a double_integrator model, since
+/// the nodes exchange relative positions and velocities, and a control rate in
+/// [kMinNodeRate, kMaxNodeRate].
+/// @throws ParameterError with the dotted key "model.type" or "controller.control_rate"
+void requireNodeScenario(const Scenario& scenario);
+
+/// As loadScenarioParameter(), with requireNodeScenario() run before the controller design's
+/// derived checks, so that a model or a rate the nodes refuse is named
+/// ("~<name>/model/type", "~<name>/controller/control_rate") rather than a gain or
+/// "estimator/substeps" that the design derives from it.
 Scenario loadDoubleIntegratorScenario(const ros::NodeHandle& private_nh,
                                       const std::string& name = "scenario");
 

@@ -1,0 +1,135 @@
+#!/usr/bin/python3
+"""rostest: time that jumps and a process that stalls, under a running follower.
+
+~case "looping_bag": a bag of good measurements (3 s, 100 Hz) played with `rosbag play --loop
+--clock`, so that ROS time goes back at every loop. Over ~loops loops the follower reports each
+jump, never says its measurement is fresh with a negative age or tracks on one older than its
+timeout, and tracks again after every jump.
+
+~case "stall": the follower of pair.launch (Run 2, tracker on) is stopped with SIGSTOP for
+~stall_s seconds and continued. After it resumes it publishes no fallback step (the measurements
+were flowing all along), counts the stalled periods as missed, keeps tracking, and no two
+consecutive commands differ by more than ~jerk_limit / ~control_rate (controller.jerk_limit).
+
+Parameters: ~wall_deadline (s) for each awaited condition, ~measurement_timeout (s)."""
+
+import math
+import os
+import signal
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+import unittest
+import xmlrpc.client
+
+import rosbag
+import rospy
+import rostest
+from projection_collision_avoidance.msg import FollowerStatus, RelativeMeasurement
+
+import ros_test_helpers as helpers
+
+PACKAGE = "projection_collision_avoidance"
+
+
+class TimeFaults(unittest.TestCase):
+    def setUp(self):
+        self.deadline = rospy.get_param("~wall_deadline")
+        self.timeout = rospy.get_param("~measurement_timeout")
+        self.lock = threading.Lock()
+        self.statuses = []
+        rospy.Subscriber(rospy.get_param("~status_topic"), FollowerStatus, self.on_status)
+
+    def on_status(self, msg):
+        with self.lock:
+            self.statuses.append((time.monotonic(), msg))
+
+    def wait_for(self, condition, what):
+        helpers.wait_for(self, condition, f"{what}", self.deadline)
+
+    def latest(self):
+        with self.lock:
+            return self.statuses[-1][1] if self.statuses else None
+
+    def assert_honest(self, statuses):
+        for status in statuses:
+            self.assertFalse(status.measurement_fresh and status.measurement_age < 0.0,
+                             f"fresh with age {status.measurement_age}")
+            if status.mode == FollowerStatus.MODE_TRACKING:
+                self.assertLessEqual(status.measurement_age, self.timeout)
+            self.assertTrue(all(math.isfinite(u) for u in status.command))
+
+    def test_case(self):
+        getattr(self, "check_" + rospy.get_param("~case"))()
+
+    def check_looping_bag(self):
+        start = 500.0
+        with tempfile.TemporaryDirectory() as work:
+            path = os.path.join(work, "measurements.bag")
+            with rosbag.Bag(path, "w") as bag:
+                for k in range(301):
+                    stamp = rospy.Time.from_sec(start + 0.01 * k)
+                    msg = RelativeMeasurement()
+                    msg.header.stamp, msg.header.frame_id = stamp, "world"
+                    msg.position, msg.velocity = [5.0], [0.0]
+                    bag.write("/relative_measurement", msg, stamp)
+            player = subprocess.Popen(["rosbag", "play", "--loop", "--clock", "--hz=200", "-q",
+                                       path], stdout=subprocess.DEVNULL)
+            try:
+                loops = rospy.get_param("~loops")
+                self.wait_for(lambda: self.latest() is not None and
+                              self.latest().time_jumps >= loops, f"fewer than {loops} jumps")
+            finally:
+                player.send_signal(signal.SIGINT)
+                player.wait(timeout=10)
+        with self.lock:
+            statuses = list(self.statuses)
+        self.assert_honest([s for _, s in statuses])
+        # After every jump back the follower tracks again.
+        for jump in range(1, loops + 1):
+            after = [s for _, s in statuses if s.time_jumps == jump]
+            self.assertTrue(any(s.mode == FollowerStatus.MODE_TRACKING for s in after),
+                            f"no tracking after jump {jump}")
+
+    def check_stall(self):
+        node = rospy.get_param("~follower_node")
+        self.wait_for(lambda: self.latest() is not None and
+                      self.latest().mode == FollowerStatus.MODE_TRACKING and
+                      self.latest().header.stamp.to_sec() > 5.0, "the follower does not track")
+        code, _, api = rospy.get_master().lookupNode(node)
+        self.assertEqual(code, 1, f"{node} unknown to the master")
+        pid = xmlrpc.client.ServerProxy(api).getPid(rospy.get_name())[2]
+        before = self.latest()
+        os.kill(pid, signal.SIGSTOP)
+        try:
+            time.sleep(rospy.get_param("~stall_s"))
+        finally:
+            os.kill(pid, signal.SIGCONT)
+        resumed = time.monotonic()
+        time.sleep(3.0)
+        with self.lock:
+            after = [s for t, s in self.statuses if s.ticks > before.ticks]
+        self.assertTrue(after, "no status after the stall")
+        self.assert_honest(after)
+        fallback = [s.header.stamp.to_sec() for s in after
+                    if s.mode == FollowerStatus.MODE_MEASUREMENT_LOST]
+        self.assertFalse(fallback, f"fallback steps after the stall at {fallback[:5]}")
+        stalled_periods = rospy.get_param("~stall_s") * rospy.get_param("~control_rate")
+        self.assertGreaterEqual(after[-1].missed_periods - before.missed_periods,
+                                0.5 * stalled_periods)
+        self.assertEqual(after[-1].mode, FollowerStatus.MODE_TRACKING)
+        # Consecutive commands, the one before the stall included, differ by at most J T.
+        max_change = rospy.get_param("~jerk_limit") / rospy.get_param("~control_rate")
+        steps = [before] + after
+        for previous, status in zip(steps, steps[1:]):
+            change = math.sqrt(sum((a - b) ** 2 for a, b in zip(status.command, previous.command)))
+            self.assertLessEqual(change, max_change + 1e-9,
+                                 f"command jumps by {change} m/s^2 at tick {status.ticks}")
+        self.assertLess(time.monotonic() - resumed, self.deadline)
+
+
+if __name__ == "__main__":
+    rospy.init_node("test_time_faults")
+    rostest.rosrun(PACKAGE, "time_faults", TimeFaults, sys.argv)
