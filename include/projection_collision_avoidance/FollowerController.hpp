@@ -39,6 +39,35 @@ struct FollowerControllerStatus {
   bool command_overflow = false;
   /// The estimator discarded a non-finite substep and held the estimate (EstimatorPeriodReport).
   bool estimate_held = false;
+
+  FollowerControllerStatus() = default;
+  /// The same status in other (compatible) dimensions, e.g. fixed to bounded: the one place that
+  /// lists the fields.
+  template <typename OtherDims>
+  explicit FollowerControllerStatus(const FollowerControllerStatus<OtherDims>& other) {
+    *this = other;
+  }
+  template <typename OtherDims>
+  FollowerControllerStatus& operator=(const FollowerControllerStatus<OtherDims>& other) {
+    command = other.command;
+    baseline_command = other.baseline_command;
+    tracker_command = other.tracker_command;
+    feedforward_command = other.feedforward_command;
+    fallback_command = other.fallback_command;
+    estimate = other.estimate;
+    estimate_norm = other.estimate_norm;
+    constraint_value = other.constraint_value;
+    command_saturated = other.command_saturated;
+    command_rate_limited = other.command_rate_limited;
+    fallback = other.fallback;
+    projection_active = other.projection_active;
+    boundary_correction = other.boundary_correction;
+    measurement_rejected = other.measurement_rejected;
+    leader_input_rejected = other.leader_input_rejected;
+    command_overflow = other.command_overflow;
+    estimate_held = other.estimate_held;
+    return *this;
+  }
 };
 
 /// The follower's controller: baseline law (2) augmented (10) by the CF tracker (19), which

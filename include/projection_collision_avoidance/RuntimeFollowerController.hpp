@@ -10,27 +10,9 @@
 
 namespace projection_collision_avoidance {
 
-/// FollowerControllerStatus with run-time sized vectors, for callers that learn the model's sizes
-/// from configuration (the ROS nodes). The vectors are sized once; a step only overwrites them.
-struct RuntimeFollowerStatus {
-  Eigen::VectorXd command;              ///< u_2
-  Eigen::VectorXd baseline_command;     ///< G y (2)
-  Eigen::VectorXd tracker_command;      ///< u_a (19)
-  Eigen::VectorXd feedforward_command;  ///< u_1 when shared into the command
-  Eigen::VectorXd fallback_command;     ///< K_f xi_hat in the fallback, else 0
-  Eigen::VectorXd estimate;             ///< xi_hat used at this tick (m)
-  double estimate_norm = 0.0;           ///< ||xi_hat|| (m)
-  double constraint_value = 0.0;        ///< f(xi_hat) (13)
-  bool command_saturated = false;       ///< the command was scaled onto acceleration_limit
-  bool command_rate_limited = false;    ///< the command's change was limited to jerk_limit T
-  bool fallback = false;                ///< this tick ran the fallback (no usable measurement)
-  bool projection_active = false;
-  double boundary_correction = 0.0;    ///< (m)
-  bool measurement_rejected = false;   ///< y had a non-finite entry: treated as missing
-  bool leader_input_rejected = false;  ///< u_1 had a non-finite entry: taken as unknown
-  bool command_overflow = false;       ///< the laws' command was not finite and was replaced
-  bool estimate_held = false;          ///< an estimator substep overflowed and was discarded
-};
+/// The status of a controller whose sizes are known at run time: FollowerControllerStatus with
+/// bounded vectors (inline storage: copying one allocates nothing).
+using RuntimeFollowerStatus = FollowerControllerStatus<GenericDimensions>;
 
 /// A FollowerController whose compile-time dimensions are chosen at run time from the model
 /// (visitDimensions()): fixed-size for 1/2/3-axis double integrators, bounded otherwise. A step
@@ -61,6 +43,12 @@ class RuntimeFollowerController {
   /// limit, from which the next command's change is limited. Throws std::invalid_argument if the
   /// model's sizes change.
   void setDesign(const ControllerDesign& design);
+
+  /// Takes over the estimate (moved into this design's Omega_1, when @p other has one) and the
+  /// previous command (moved into this acceleration limit) of @p other, a controller of the same
+  /// model sizes, as setDesign() keeps its own. Allocates nothing.
+  /// @throws std::invalid_argument when the sizes differ
+  void adoptStateOf(const RuntimeFollowerController& other);
 
   /// Forgets the estimate and the previous command (zero, a vehicle at rest); the next step
   /// initialises the estimate as configured.

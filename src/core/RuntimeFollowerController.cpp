@@ -10,23 +10,7 @@ namespace {
 
 template <typename Dims>
 void copyStatus(const FollowerControllerStatus<Dims>& from, RuntimeFollowerStatus* to) {
-  to->command = from.command;
-  to->baseline_command = from.baseline_command;
-  to->tracker_command = from.tracker_command;
-  to->feedforward_command = from.feedforward_command;
-  to->fallback_command = from.fallback_command;
-  to->estimate = from.estimate;
-  to->estimate_norm = from.estimate_norm;
-  to->constraint_value = from.constraint_value;
-  to->command_saturated = from.command_saturated;
-  to->command_rate_limited = from.command_rate_limited;
-  to->fallback = from.fallback;
-  to->projection_active = from.projection_active;
-  to->boundary_correction = from.boundary_correction;
-  to->measurement_rejected = from.measurement_rejected;
-  to->leader_input_rejected = from.leader_input_rejected;
-  to->command_overflow = from.command_overflow;
-  to->estimate_held = from.estimate_held;
+  *to = from;
 }
 
 }  // namespace
@@ -42,12 +26,12 @@ RuntimeFollowerController::RuntimeFollowerController(const ControllerDesign& des
     : controller_(makeController(design)) {
   const Eigen::Index n = design.parameters.model.stateDimension();
   const Eigen::Index m = design.parameters.model.inputDimension();
-  status_.command = Eigen::VectorXd::Zero(m);
-  status_.baseline_command = Eigen::VectorXd::Zero(m);
-  status_.tracker_command = Eigen::VectorXd::Zero(m);
-  status_.feedforward_command = Eigen::VectorXd::Zero(m);
-  status_.fallback_command = Eigen::VectorXd::Zero(m);
-  status_.estimate = Eigen::VectorXd::Zero(n);
+  status_.command.setZero(m);
+  status_.baseline_command.setZero(m);
+  status_.tracker_command.setZero(m);
+  status_.feedforward_command.setZero(m);
+  status_.fallback_command.setZero(m);
+  status_.estimate.setZero(n);
 }
 
 const RuntimeFollowerStatus& RuntimeFollowerController::step(
@@ -119,6 +103,24 @@ void RuntimeFollowerController::setDesign(const ControllerDesign& design) {
       },
       replacement);
   controller_ = std::move(replacement);
+}
+
+void RuntimeFollowerController::adoptStateOf(const RuntimeFollowerController& other) {
+  if (controller_.index() != other.controller_.index() ||
+      stateDimension() != other.stateDimension() || inputDimension() != other.inputDimension() ||
+      outputDimension() != other.outputDimension()) {
+    throw std::invalid_argument("RuntimeFollowerController::adoptStateOf: model sizes differ");
+  }
+  std::visit(
+      [&](auto& controller) {
+        using Controller = std::decay_t<decltype(controller)>;
+        const Controller& source = std::get<Controller>(other.controller_);
+        controller.setPreviousCommand(source.previousCommand());
+        if (source.initialized()) {
+          controller.resetEstimate(source.estimate());
+        }
+      },
+      controller_);
 }
 
 void RuntimeFollowerController::reset() {

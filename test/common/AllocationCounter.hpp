@@ -11,6 +11,10 @@ namespace testing {
 
 /// Allocations (malloc, calloc, realloc, memalign, aligned_alloc, posix_memalign) since start.
 long allocationCount();
+/// Allocations made by the calling thread since it started.
+long threadAllocationCount();
+/// Blocks freed (free of a non-null pointer) by the calling thread since it started.
+long threadFreeCount();
 
 }  // namespace testing
 }  // namespace projection_collision_avoidance

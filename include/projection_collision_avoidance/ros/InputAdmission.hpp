@@ -17,6 +17,13 @@ inline std::int64_t nanosecondsOf(const ros::Time& time) {
   return static_cast<std::int64_t>(time.toNSec());
 }
 
+/// The ros::Time of @p ns since the epoch (0 for a negative value).
+inline ros::Time rosTimeOf(std::int64_t ns) {
+  ros::Time time;
+  time.fromNSec(static_cast<std::uint64_t>(ns < 0 ? 0 : ns));
+  return time;
+}
+
 /// later - earlier (s), without the range exception of ros::Duration.
 inline double secondsBetween(const ros::Time& later, const ros::Time& earlier) {
   return 1e-9 * static_cast<double>(nanosecondsOf(later) - nanosecondsOf(earlier));

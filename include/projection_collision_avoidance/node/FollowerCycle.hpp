@@ -1,0 +1,159 @@
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+
+#include "projection_collision_avoidance/FollowerMode.hpp"
+#include "projection_collision_avoidance/RuntimeFollowerController.hpp"
+#include "projection_collision_avoidance/TypeDefs.hpp"
+#include "projection_collision_avoidance/rt/LatestValue.hpp"
+
+namespace projection_collision_avoidance {
+
+/// Control periods skipped between two consecutive due times @p gap s apart (s): none up to 1.5
+/// periods, else round(gap / period) - 1 (saturated).
+std::uint32_t skippedPeriods(double gap, double period);
+
+/// One accepted relative measurement, as the input side hands it to the control cycle.
+struct MeasurementSample {
+  std::int64_t stamp_ns = 0;    ///< its header stamp (ns since the epoch)
+  std::int64_t receipt_ns = 0;  ///< ROS time when it was accepted (ns)
+  std::uint64_t sequence = 0;   ///< measurements accepted so far, this one included
+  GenericDimensions::StateVector relative_state;  ///< x_target - x_i (m, m/s)
+};
+
+/// One accepted leader broadcast: the target's acceleration as the follower uses it.
+struct LeaderSample {
+  std::int64_t stamp_ns = 0;
+  std::int64_t receipt_ns = 0;
+  std::uint64_t sequence = 0;
+  GenericDimensions::InputVector acceleration;  ///< a_target (m/s^2)
+};
+
+/// What the follower's control cycle needs besides the controller's design.
+struct FollowerCycleSettings {
+  double measurement_timeout = 0.5;   ///< s: an older measurement is stale
+  double leader_timeout = 0.5;        ///< s: an older leader broadcast is stale
+  bool use_leader_input = false;      ///< give the controller a fresh leader acceleration
+  bool measurement_trigger = false;   ///< steps answer measurements; ticks only brake
+};
+
+/// What a tick or step gives the outputs: the step's results when one ran, and the counters.
+/// Fixed size: filling it allocates nothing.
+struct FollowerCycleOutput {
+  bool stepped = false;           ///< a control step ran (else: waiting, stalled, or a tick of the
+                                  ///< measurement trigger while the measurement is fresh)
+  std::int64_t stamp_ns = 0;      ///< the step's stamp: tick time, or the measurement's stamp
+  std::uint64_t steps = 0;        ///< control steps run since start, this one included
+  FollowerMode mode = FollowerMode::kWaiting;
+  bool leader_fresh = false;
+  double measurement_age = 0.0;   ///< s at the stamp; +inf when none on this timeline
+  double leader_age = 0.0;        ///< s at the stamp; +inf when none on this timeline
+  GenericDimensions::StateVector xi;  ///< x_target - x_i - d of the measurement used (m, m/s)
+  double distance = 0.0;              ///< ||p_target - p_i|| of that measurement (m)
+  RuntimeFollowerStatus status;       ///< the controller's step
+  double xi_max = 0.0;                ///< (1 - alpha) ||d|| in force (m)
+  double xi_soft = 0.0;               ///< xi_max / sqrt(1 + epsilon) in force (m)
+  double perimeter = 0.0;             ///< alpha ||d|| in force (m)
+  double acceleration_limit = 0.0;    ///< in force (m/s^2)
+  double jerk_limit = 0.0;            ///< in force (m/s^3)
+  bool tracker_enabled = false;       ///< in force
+  std::uint32_t missed_periods = 0;
+  std::uint32_t late_periods = 0;
+  double tick_delay = 0.0;            ///< s, of the latest step
+  std::uint32_t time_jumps = 0;       ///< jumps back of ROS time since start
+  double time_jump = 0.0;             ///< s (negative): the jump seen at this tick, else 0
+  double stall = 0.0;                 ///< s: a tick this late began a wait for input, else 0
+};
+
+/// The follower's control cycle without ROS: it reads the latest accepted inputs from lock-free
+/// slots the input side writes (measurement(), leader()), decides the mode from their ages,
+/// runs one step of the controller and fills a FollowerCycleOutput. Nothing in tick() or
+/// stepOnMeasurement() allocates, locks (except under the measurement trigger, whose steps
+/// run in the measurement's callback) or makes a system call, so that a real-time thread can run
+/// it.
+///
+/// Time: every call gives the ROS time `now_ns`. An input is valid while it was received at or
+/// before now (after a jump back of ROS time, those of the old timeline are not, so the follower
+/// brakes until new ones arrive); its age counts from min(stamp, receipt). A tick more than half
+/// the measurement timeout late (a stalled process) starts a wait: ticks are skipped and counted
+/// as missed until a measurement arrives or half the timeout has passed.
+class FollowerCycle {
+ public:
+  /// @param controller the controller, moved in
+  /// @param separation d of this follower's slot (n entries)
+  FollowerCycle(std::unique_ptr<RuntimeFollowerController> controller,
+                const Eigen::VectorXd& separation, FollowerCycleSettings settings);
+  ~FollowerCycle();
+  FollowerCycle(const FollowerCycle&) = delete;
+  FollowerCycle& operator=(const FollowerCycle&) = delete;
+
+  /// The slot the measurement callback writes (one writer thread).
+  LatestValue<MeasurementSample>& measurement() { return measurement_; }
+  /// The slot the leader-broadcast callback writes (one writer thread).
+  LatestValue<LeaderSample>& leader() { return leader_; }
+
+  /// A tick of the fixed-rate loop at ROS time @p now_ns, @p delay s after it was due, with
+  /// @p skipped periods skipped before it. Timer trigger: a step stamped now. Measurement
+  /// trigger: a braking step once the measurement is stale, else nothing.
+  /// @return whether @p out got a step (out->stepped); the counters are filled either way
+  bool tick(std::int64_t now_ns, double delay, std::uint32_t skipped, FollowerCycleOutput* out);
+
+  /// The step answering the measurement just written to measurement() (measurement trigger),
+  /// stamped with its stamp, at ROS time @p now_ns; @p skipped periods since the one before.
+  bool stepOnMeasurement(std::int64_t now_ns, std::uint32_t skipped, FollowerCycleOutput* out);
+
+  /// Hands over a controller for a new design (built elsewhere, e.g. by reconfiguration); a
+  /// coming tick adopts it, carrying over the estimate and previous command, once the controller
+  /// it replaced last time has been collected with retired(). A controller offered before and
+  /// not yet adopted is returned for disposal.
+  std::unique_ptr<RuntimeFollowerController> offer(
+      std::unique_ptr<RuntimeFollowerController> controller);
+  /// The controller replaced by the last adoption, for disposal off the control thread.
+  std::unique_ptr<RuntimeFollowerController> retired();
+
+  /// Design in force at the last tick (read it from the control thread only, or before start).
+  const ControllerDesign& design() const { return controller_->design(); }
+
+ private:
+  /// One control step stamped @p stamp_ns, @p delay s after it was due.
+  bool step(std::int64_t stamp_ns, double delay, FollowerCycleOutput* out);
+  void readInputs(std::int64_t now_ns);
+  void adoptOffered();
+  void fillCounters(FollowerCycleOutput* out) const;
+
+  std::unique_ptr<RuntimeFollowerController> controller_;
+  std::atomic<RuntimeFollowerController*> offered_{nullptr};
+  std::atomic<RuntimeFollowerController*> retired_{nullptr};
+  GenericDimensions::StateVector separation_;
+  FollowerCycleSettings settings_;
+  double period_ = 0.0;
+  std::mutex trigger_mutex_;  ///< measurement trigger only: callback steps vs braking ticks
+
+  LatestValue<MeasurementSample> measurement_;
+  LatestValue<LeaderSample> leader_;
+  bool have_measurement_ = false;  ///< a measurement valid on this timeline
+  bool ever_measured_ = false;     ///< a measurement was accepted since start
+  bool have_leader_ = false;
+  bool ever_led_ = false;
+
+  bool have_latest_time_ = false;
+  std::int64_t latest_time_ns_ = 0;  ///< latest ROS time seen (jumps back)
+  std::uint32_t time_jumps_ = 0;
+  double time_jump_ = 0.0;
+  bool resuming_ = false;            ///< waiting for input after a stall
+  std::int64_t resumed_at_ns_ = 0;
+  std::uint64_t sequence_at_stall_ = 0;
+  double stall_ = 0.0;
+
+  FollowerMode mode_ = FollowerMode::kWaiting;
+  std::uint64_t steps_ = 0;
+  std::uint32_t missed_periods_ = 0;
+  std::uint32_t late_periods_ = 0;
+  double tick_delay_ = 0.0;
+  GenericDimensions::OutputVector y_;
+};
+
+}  // namespace projection_collision_avoidance

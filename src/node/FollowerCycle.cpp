@@ -1,0 +1,230 @@
+#include "projection_collision_avoidance/node/FollowerCycle.hpp"
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <utility>
+
+namespace projection_collision_avoidance {
+namespace {
+
+constexpr double kNanosecond = 1e-9;
+
+/// Adds without wrapping around.
+void addSaturated(std::uint32_t* counter, std::uint32_t amount) {
+  *counter = *counter > std::numeric_limits<std::uint32_t>::max() - amount
+                 ? std::numeric_limits<std::uint32_t>::max()
+                 : *counter + amount;
+}
+
+/// Age (s) at @p at_ns of an input stamped @p stamp_ns and received at @p receipt_ns: from the
+/// earlier of the two, so that a stamp ahead of the receiver's clock counts from its receipt.
+double ageOf(std::int64_t at_ns, std::int64_t stamp_ns, std::int64_t receipt_ns) {
+  return kNanosecond * static_cast<double>(at_ns - std::min(stamp_ns, receipt_ns));
+}
+
+}  // namespace
+
+std::uint32_t skippedPeriods(double gap, double period) {
+  if (!(gap > 1.5 * period)) {
+    return 0;
+  }
+  const double skipped = std::round(gap / period) - 1.0;
+  return skipped >= static_cast<double>(std::numeric_limits<std::uint32_t>::max())
+             ? std::numeric_limits<std::uint32_t>::max()
+             : static_cast<std::uint32_t>(skipped);
+}
+
+FollowerCycle::FollowerCycle(std::unique_ptr<RuntimeFollowerController> controller,
+                             const Eigen::VectorXd& separation, FollowerCycleSettings settings)
+    : controller_(std::move(controller)), separation_(separation), settings_(settings) {
+  if (!controller_ || separation.size() != controller_->stateDimension()) {
+    throw std::invalid_argument("FollowerCycle: a controller and d of its state's size");
+  }
+  period_ = controller_->design().period;
+  y_.resize(controller_->outputDimension());
+}
+
+FollowerCycle::~FollowerCycle() {
+  delete offered_.exchange(nullptr);
+  delete retired_.exchange(nullptr);
+}
+
+std::unique_ptr<RuntimeFollowerController> FollowerCycle::offer(
+    std::unique_ptr<RuntimeFollowerController> controller) {
+  if (!controller || controller->stateDimension() != controller_->stateDimension() ||
+      controller->inputDimension() != controller_->inputDimension() ||
+      controller->outputDimension() != controller_->outputDimension()) {
+    throw std::invalid_argument("FollowerCycle::offer: a controller of the same model sizes");
+  }
+  return std::unique_ptr<RuntimeFollowerController>(offered_.exchange(controller.release()));
+}
+
+std::unique_ptr<RuntimeFollowerController> FollowerCycle::retired() {
+  return std::unique_ptr<RuntimeFollowerController>(retired_.exchange(nullptr));
+}
+
+void FollowerCycle::adoptOffered() {
+  if (retired_.load(std::memory_order_acquire) != nullptr) {
+    return;  // the previous one is not collected yet: adopt at a later tick
+  }
+  RuntimeFollowerController* next = offered_.exchange(nullptr);
+  if (next == nullptr) {
+    return;
+  }
+  next->adoptStateOf(*controller_);
+  retired_.store(controller_.release(), std::memory_order_release);
+  controller_.reset(next);
+}
+
+void FollowerCycle::readInputs(std::int64_t now_ns) {
+  if (measurement_.read()) {
+    ever_measured_ = true;
+  }
+  if (leader_.read()) {
+    ever_led_ = true;
+  }
+  // An input of the old timeline (received after now: ROS time went back) is not valid.
+  have_measurement_ = ever_measured_ && measurement_.value().receipt_ns <= now_ns;
+  have_leader_ = ever_led_ && leader_.value().receipt_ns <= now_ns;
+}
+
+bool FollowerCycle::tick(std::int64_t now_ns, double delay, std::uint32_t skipped,
+                         FollowerCycleOutput* out) {
+  std::unique_lock<std::mutex> lock(trigger_mutex_, std::defer_lock);
+  out->stepped = false;
+  if (settings_.measurement_trigger && !lock.try_lock()) {
+    fillCounters(out);  // a measurement's step runs right now: nothing to brake for
+    return false;
+  }
+  time_jump_ = 0.0;
+  stall_ = 0.0;
+  if (have_latest_time_ && now_ns < latest_time_ns_) {
+    ++time_jumps_;
+    time_jump_ = kNanosecond * static_cast<double>(now_ns - latest_time_ns_);
+    resuming_ = false;
+  }
+  latest_time_ns_ = now_ns;
+  have_latest_time_ = true;
+  adoptOffered();
+  readInputs(now_ns);
+
+  const double grace = 0.5 * settings_.measurement_timeout;
+  if (delay > grace) {
+    // The tick itself ran late by a good part of the timeout: the process was stalled, and the
+    // measurements sent meanwhile are not read yet. Wait for them (at most `grace` s).
+    resuming_ = true;
+    resumed_at_ns_ = now_ns;
+    sequence_at_stall_ = measurement_.value().sequence;
+    stall_ = delay;
+  }
+  if (resuming_) {
+    if (measurement_.value().sequence == sequence_at_stall_ &&
+        kNanosecond * static_cast<double>(now_ns - resumed_at_ns_) < grace) {
+      addSaturated(&missed_periods_, skipped + 1);
+      fillCounters(out);
+      return false;
+    }
+    resuming_ = false;
+  }
+  if (!settings_.measurement_trigger) {
+    addSaturated(&missed_periods_, skipped);
+    return step(now_ns, delay, out);
+  }
+  // Measurement trigger: the measurements run the steps while they are fresh; a tick only
+  // brakes once they are stale.
+  const bool fresh = have_measurement_ &&
+                     ageOf(now_ns, measurement_.value().stamp_ns,
+                           measurement_.value().receipt_ns) <= settings_.measurement_timeout;
+  if (ever_measured_ && !fresh) {
+    return step(now_ns, delay, out);
+  }
+  fillCounters(out);
+  return false;
+}
+
+bool FollowerCycle::stepOnMeasurement(std::int64_t now_ns, std::uint32_t skipped,
+                                      FollowerCycleOutput* out) {
+  const std::lock_guard<std::mutex> lock(trigger_mutex_);
+  adoptOffered();
+  readInputs(now_ns);
+  if (!have_measurement_) {
+    out->stepped = false;
+    fillCounters(out);
+    return false;
+  }
+  addSaturated(&missed_periods_, skipped);
+  const MeasurementSample& m = measurement_.value();
+  return step(m.stamp_ns, kNanosecond * static_cast<double>(now_ns - m.stamp_ns), out);
+}
+
+bool FollowerCycle::step(std::int64_t stamp_ns, double delay, FollowerCycleOutput* out) {
+  FollowerInputAges ages;
+  ages.have_measurement = ever_measured_;
+  ages.measurement_age =
+      have_measurement_ ? ageOf(stamp_ns, measurement_.value().stamp_ns,
+                                measurement_.value().receipt_ns)
+                        : std::numeric_limits<double>::infinity();
+  ages.have_leader = ever_led_;
+  ages.leader_age = have_leader_ ? ageOf(stamp_ns, leader_.value().stamp_ns,
+                                         leader_.value().receipt_ns)
+                                 : std::numeric_limits<double>::infinity();
+  mode_ = selectFollowerMode(
+      ages, FollowerTimeouts{settings_.measurement_timeout, settings_.leader_timeout});
+  out->stepped = false;
+  out->mode = mode_;
+  if (mode_ == FollowerMode::kWaiting) {
+    fillCounters(out);
+    return false;
+  }
+  ++steps_;
+  tick_delay_ = delay;
+  if (delay > 0.5 * period_) {
+    addSaturated(&late_periods_, 1);
+  }
+  out->leader_fresh = have_leader_ && ages.leader_age <= settings_.leader_timeout;
+  const bool use_leader = settings_.use_leader_input && out->leader_fresh;
+  const ControllerDesign& design = controller_->design();
+  const GenericDimensions::StateVector& state = measurement_.value().relative_state;
+  out->xi = state - separation_;
+  const Eigen::Index axes = design.parameters.model.position_dimension;
+  out->distance = state.head(axes).norm();
+  const RuntimeFollowerStatus* status = nullptr;
+  if (mode_ == FollowerMode::kMeasurementLost) {
+    status = use_leader ? &controller_->stepFallback(leader_.value().acceleration)
+                        : &controller_->stepFallback();
+  } else {
+    y_.noalias() = design.parameters.model.C * out->xi;
+    status = use_leader ? &controller_->step(y_, leader_.value().acceleration)
+                        : &controller_->step(y_);
+  }
+  out->stepped = true;
+  out->stamp_ns = stamp_ns;
+  out->steps = steps_;
+  out->measurement_age = ages.measurement_age;
+  out->leader_age = ages.leader_age;
+  out->status = *status;
+  out->xi_max = design.xi_max;
+  out->xi_soft = design.xi_soft;
+  out->perimeter = design.perimeter;
+  out->acceleration_limit = design.parameters.acceleration_limit;
+  out->jerk_limit = design.parameters.jerk_limit;
+  out->tracker_enabled = design.parameters.tracker_enabled;
+  fillCounters(out);
+  return true;
+}
+
+void FollowerCycle::fillCounters(FollowerCycleOutput* out) const {
+  out->mode = mode_;
+  out->missed_periods = missed_periods_;
+  out->late_periods = late_periods_;
+  out->tick_delay = tick_delay_;
+  out->time_jumps = time_jumps_;
+  out->time_jump = time_jump_;
+  out->stall = stall_;
+  if (!out->stepped) {
+    out->steps = steps_;
+  }
+}
+
+}  // namespace projection_collision_avoidance

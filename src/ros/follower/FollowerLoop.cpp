@@ -1,0 +1,73 @@
+#include "follower/FollowerLoop.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "projection_collision_avoidance/ParameterError.hpp"
+#include "projection_collision_avoidance/ros/InputAdmission.hpp"
+
+namespace projection_collision_avoidance {
+
+FollowerLoop::FollowerLoop(ros::NodeHandle nh, const FollowerNodeOptions& options,
+                           double control_rate, FollowerCycle* cycle, FollowerOutputs* outputs)
+    : cycle_(cycle), outputs_(outputs), period_(1.0 / control_rate) {
+  if (options.control_loop == ControlLoop::kThread) {
+    const int priority = options.control_priority;
+    try {
+      thread_.start(std::chrono::nanoseconds(std::llround(1e9 / control_rate)), priority,
+                    [this](const PeriodicTick& tick) { onThreadTick(tick); });
+    } catch (const PriorityRefused& error) {
+      throw ParameterError("~control_priority",
+                           "SCHED_FIFO priority " + std::to_string(priority) +
+                               " refused: pthread_setschedparam failed: " + error.code().message() +
+                               " (needs root or CAP_SYS_NICE, or an RLIMIT_RTPRIO of at least " +
+                               std::to_string(priority) + "; 0 runs without real-time priority)");
+    }
+    return;
+  }
+  ros::TimerOptions timer_options(
+      ros::Duration(period_), [this](const ros::TimerEvent& event) { onTimer(event); }, &queue_);
+  timer_ = nh.createTimer(timer_options);
+  spinner_ = std::make_unique<ros::AsyncSpinner>(1, &queue_);
+  spinner_->start();
+}
+
+FollowerLoop::~FollowerLoop() {
+  thread_.stop();
+  timer_.stop();
+  if (spinner_) {
+    spinner_->stop();
+  }
+}
+
+void FollowerLoop::onTimer(const ros::TimerEvent& event) {
+  try {
+    const double delay = secondsBetween(event.current_real, event.current_expected);
+    std::uint32_t skipped = 0;
+    if (have_last_expected_ && event.current_expected > last_expected_) {
+      skipped = skippedPeriods(secondsBetween(event.current_expected, last_expected_), period_);
+    }
+    last_expected_ = event.current_expected;
+    have_last_expected_ = true;
+    cycle_->tick(nanosecondsOf(ros::Time::now()), delay, skipped, &timer_output_);
+    outputs_->publish(timer_output_);
+  } catch (const std::exception& error) {
+    ROS_ERROR_STREAM_THROTTLE(5.0, "control tick failed: " << error.what());
+  }
+}
+
+void FollowerLoop::onThreadTick(const PeriodicTick& tick) {
+  if (!ros::ok()) {  // shutting down: the timer's spinner would not call it either
+    return;
+  }
+  const double delay = 1e-9 * static_cast<double>(tick.actual - tick.expected);
+  const std::uint64_t most = std::numeric_limits<std::uint32_t>::max();
+  cycle_->tick(nanosecondsOf(ros::Time::now()), delay,
+               static_cast<std::uint32_t>(std::min(tick.skipped, most)), &thread_output_);
+  outputs_->post(thread_output_);
+}
+
+}  // namespace projection_collision_avoidance

@@ -1,0 +1,56 @@
+#pragma once
+
+#include <cstdint>
+#include <memory>
+
+#include <ros/callback_queue.h>
+#include <ros/ros.h>
+
+#include "follower/FollowerOptions.hpp"
+#include "follower/FollowerOutputs.hpp"
+#include "projection_collision_avoidance/node/FollowerCycle.hpp"
+#include "projection_collision_avoidance/ros/RealtimeLoop.hpp"
+
+namespace projection_collision_avoidance {
+
+/// What runs the follower's fixed-rate tick (~control_loop) and its period accounting.
+///
+/// "timer": a ros::Timer (ROS time; simulated time works) on a callback queue and spinner thread
+/// of their own, so that a flood of input messages cannot delay a tick; the tick publishes on
+/// that thread. Missed periods: the timer's expected times more than 1.5 periods apart count
+/// round(gap / T) - 1.
+///
+/// "thread": a PeriodicThread sleeping to absolute CLOCK_MONOTONIC deadlines k T, optionally
+/// under SCHED_FIFO (~control_priority), stamped with ros::Time::now() (wall time only). Its tick
+/// allocates and blocks on nothing (with ~trigger timer): the cycle reads lock-free slots and
+/// its output goes through FollowerOutputs::post() to the outputs' thread. Missed periods: the
+/// deadlines the thread skipped.
+class FollowerLoop {
+ public:
+  /// Starts the loop at @p control_rate Hz.
+  /// @throws ParameterError naming ~control_priority when the kernel refuses the priority
+  FollowerLoop(ros::NodeHandle nh, const FollowerNodeOptions& options, double control_rate,
+               FollowerCycle* cycle, FollowerOutputs* outputs);
+  /// Stops the loop (the thread within one period, at most 10 ms, and a running tick).
+  ~FollowerLoop();
+  FollowerLoop(const FollowerLoop&) = delete;
+  FollowerLoop& operator=(const FollowerLoop&) = delete;
+
+ private:
+  void onTimer(const ros::TimerEvent& event);
+  void onThreadTick(const PeriodicTick& tick);
+
+  FollowerCycle* cycle_;
+  FollowerOutputs* outputs_;
+  double period_;
+  FollowerCycleOutput timer_output_;   ///< the timer thread's
+  FollowerCycleOutput thread_output_;  ///< the control thread's
+  ros::Time last_expected_;
+  bool have_last_expected_ = false;
+  ros::CallbackQueue queue_;
+  ros::Timer timer_;
+  std::unique_ptr<ros::AsyncSpinner> spinner_;
+  PeriodicThread thread_;  ///< started last, stopped first
+};
+
+}  // namespace projection_collision_avoidance

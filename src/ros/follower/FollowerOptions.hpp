@@ -1,0 +1,66 @@
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "projection_collision_avoidance/ControllerParameters.hpp"
+#include "projection_collision_avoidance/Formation.hpp"
+#include "projection_collision_avoidance/Scenario.hpp"
+#include "projection_collision_avoidance/ros/RosParameters.hpp"
+
+namespace projection_collision_avoidance {
+
+/// What runs the follower's control steps (~trigger).
+enum class ControlTrigger : std::uint8_t {
+  kTimer,        ///< "timer": a timer at control_rate, on the latest accepted measurement
+  kMeasurement,  ///< "measurement": each accepted measurement, at once, stamped with its stamp
+};
+
+/// "timer" or "measurement".
+const char* toString(ControlTrigger trigger);
+
+/// What runs the follower's fixed-rate control tick (~control_loop).
+enum class ControlLoop : std::uint8_t {
+  kTimer,   ///< "timer": a ros::Timer on a callback queue and spinner thread of its own
+  kThread,  ///< "thread": a PeriodicThread sleeping to absolute CLOCK_MONOTONIC deadlines
+};
+
+/// "timer" or "thread".
+const char* toString(ControlLoop loop);
+
+/// Highest ~control_priority (SCHED_FIFO's highest priority on Linux).
+constexpr int kMaxControlPriority = 99;
+
+/// The follower node's own options (besides the scenario), read once from its private namespace.
+struct FollowerNodeOptions {
+  double measurement_timeout = 0.5;    ///< s; an older measurement puts the follower in fallback
+  double leader_timeout = 0.5;         ///< s; an older leader broadcast is not used
+  double max_future_stamp = 0.1;       ///< s; inputs stamped after now + this are refused
+  bool use_leader_broadcast = false;   ///< use u_1 from leader_broadcast (always monitored)
+  std::string measurement_frame;       ///< required frame_id of measurements ("" = any)
+  std::string leader_broadcast_frame;  ///< required frame_id of leader broadcasts ("" = any)
+  std::string follower_frame;  ///< frame of the command, status and markers (default: the name)
+  double marker_rate = 10.0;   ///< Hz
+  int formation_index = 1;     ///< i: which follower of the scenario's formation this is
+  /// ~trigger: "timer" (default) or "measurement"; see FollowerNode.
+  ControlTrigger trigger = ControlTrigger::kTimer;
+  /// ~control_loop: "timer" (default) or "thread" (wall time only); see FollowerNode.
+  ControlLoop control_loop = ControlLoop::kTimer;
+  /// ~control_priority: SCHED_FIFO priority of the control thread, 1 to 99; 0 (default) leaves
+  /// the scheduler alone. Only with control_loop "thread".
+  int control_priority = 0;
+  /// ~lock_memory: mlockall(MCL_CURRENT | MCL_FUTURE) at start (default false).
+  bool lock_memory = false;
+};
+
+/// Member ~formation_index of the scenario's formation (1 for the pair).
+/// @throws ParameterError naming ~formation_index
+FormationMember memberOf(NodeOptionReader& reader, const Scenario& scenario);
+
+/// The follower node's options from its private namespace, each validated (the message names
+/// the key): ranges, ~trigger, ~control_loop ("thread" refused under simulated time, @p sim_time),
+/// ~control_priority only with the thread loop.
+FollowerNodeOptions readFollowerOptions(NodeOptionReader& reader, const ControllerParameters& p,
+                                        const FormationMember& member, bool sim_time);
+
+}  // namespace projection_collision_avoidance

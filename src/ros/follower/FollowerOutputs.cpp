@@ -1,0 +1,199 @@
+#include "follower/FollowerOutputs.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <utility>
+
+#include <geometry_msgs/AccelStamped.h>
+#include <visualization_msgs/MarkerArray.h>
+
+#include "projection_collision_avoidance/FollowerStatus.h"
+#include "projection_collision_avoidance/LeaderBroadcast.h"
+#include "follower/StatusMessage.hpp"
+#include "projection_collision_avoidance/ros/InputAdmission.hpp"
+#include "projection_collision_avoidance/ros/MessageConversions.hpp"
+
+namespace projection_collision_avoidance {
+FollowerOutputs::FollowerOutputs(ros::NodeHandle nh, ros::NodeHandle private_nh,
+                                 std::string node_name, const FollowerNodeOptions& options,
+                                 double control_rate, const FormationMember& member,
+                                 const Eigen::VectorXd& separation, const FollowerInputs* inputs)
+    : name_(std::move(node_name)),
+      options_(options),
+      member_(member),
+      separation_(separation),
+      inputs_(inputs),
+      diagnostics_(nh, private_nh) {
+  command_publisher_ = nh.advertise<geometry_msgs::AccelStamped>("command", 10);
+  broadcast_publisher_ = nh.advertise<LeaderBroadcast>("broadcast", 10);
+  status_publisher_ = nh.advertise<FollowerStatus>("status", 10);
+  marker_publisher_ = nh.advertise<visualization_msgs::MarkerArray>("markers", 2);
+  diagnostics_.setHardwareID(options_.follower_frame);
+  diagnostics_.add("follower controller", this, &FollowerOutputs::diagnose);
+  // Markers every control_rate / marker_rate steps.
+  if (options_.marker_rate > 0.0) {
+    steps_per_marker_ =
+        static_cast<std::uint64_t>(std::max(1L, std::lround(control_rate / options_.marker_rate)));
+  }
+}
+
+FollowerOutputs::~FollowerOutputs() { stopThread(); }
+
+void FollowerOutputs::publish(const FollowerCycleOutput& out) {
+  logEvents(out);
+  latest_ = out;
+  have_latest_ = true;
+  if (out.stepped) {
+    const ros::Time stamp = rosTimeOf(out.stamp_ns);
+    command_publisher_.publish(toAccelMsg(out.status.command, stamp, options_.follower_frame));
+    LeaderBroadcast broadcast;  // for a follower behind this one: its acceleration, no state
+    broadcast.header.stamp = stamp;
+    broadcast.header.frame_id = options_.follower_frame;
+    broadcast.input = toStdVector(out.status.command);
+    broadcast_publisher_.publish(broadcast);
+    status_publisher_.publish(toStatusMsg(out, inputs_->stats(), member_, options_.follower_frame));
+    if (steps_per_marker_ > 0 && (out.steps - 1) % steps_per_marker_ == 0) {
+      publishMarkers(out);
+    }
+  }
+  diagnostics_.update();
+}
+
+void FollowerOutputs::describeTrackerGain(const Eigen::MatrixXd& gain) {
+  std::ostringstream text;  // G_e in force, row by row
+  text << gain.format(
+      Eigen::IOFormat(Eigen::StreamPrecision, Eigen::DontAlignCols, ", ", "; ", "", "", "[", "]"));
+  const std::lock_guard<std::mutex> lock(gain_mutex_);
+  tracker_gain_ = text.str();
+}
+
+void FollowerOutputs::startThread(std::function<void()> idle) {
+  stop_ = false;
+  thread_ = std::thread([this, idle = std::move(idle)] { run(idle); });
+}
+
+void FollowerOutputs::stopThread() {
+  if (!thread_.joinable()) {
+    return;
+  }
+  stop_ = true;
+  handoff_.wake();
+  thread_.join();
+}
+
+void FollowerOutputs::run(const std::function<void()>& idle) {
+  constexpr std::int64_t kIdleNs = 100000000;  // 100 ms
+  FollowerCycleOutput out;
+  std::uint32_t seen = handoff_.count();
+  while (true) {
+    while (handoff_.pop(&out)) {
+      publish(out);
+    }
+    if (idle) {
+      idle();
+    }
+    if (stop_) {
+      return;
+    }
+    seen = handoff_.wait(seen, kIdleNs);
+  }
+}
+
+void FollowerOutputs::logEvents(const FollowerCycleOutput& out) {
+  if (out.time_jump < 0.0) {
+    ROS_WARN_STREAM(name_ << ": ROS time went back by " << -out.time_jump
+                          << " s: the inputs of the old timeline are forgotten; braking until "
+                             "fresh measurements arrive");
+  }
+  if (out.stall > 0.0) {
+    ROS_WARN_STREAM_THROTTLE(5.0, name_ << ": control tick " << out.stall
+                                        << " s late (the process was stalled): waiting up to "
+                                        << 0.5 * options_.measurement_timeout
+                                        << " s for the input sent meanwhile");
+  }
+  if (out.mode == logged_mode_) {
+    return;
+  }
+  logged_mode_ = out.mode;
+  switch (out.mode) {
+    case FollowerMode::kTracking:
+      ROS_INFO_STREAM(name_ << ": tracking");
+      break;
+    case FollowerMode::kLeaderLost:
+      ROS_WARN_STREAM(name_ << ": leader broadcast older than ~leader_timeout ("
+                            << options_.leader_timeout
+                            << " s): running on the relative measurement alone");
+      break;
+    case FollowerMode::kMeasurementLost:
+      ROS_ERROR_STREAM(name_ << ": relative measurement older than ~measurement_timeout ("
+                             << options_.measurement_timeout
+                             << " s): braking relative to the leader until it returns");
+      break;
+    case FollowerMode::kWaiting:
+      break;
+  }
+}
+
+void FollowerOutputs::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  using diagnostic_msgs::DiagnosticStatus;
+  const FollowerCycleOutput& s = latest_;
+  const FollowerInputStats inputs = inputs_->stats();
+  switch (s.mode) {
+    case FollowerMode::kWaiting:
+      status.summary(DiagnosticStatus::ERROR, "no relative measurement yet");
+      break;
+    case FollowerMode::kMeasurementLost:
+      status.summary(DiagnosticStatus::ERROR, "relative measurement lost: braking fallback");
+      break;
+    case FollowerMode::kLeaderLost:
+      status.summary(DiagnosticStatus::WARN, "leader broadcast lost: running without u_1");
+      break;
+    case FollowerMode::kTracking:
+      status.summary(DiagnosticStatus::OK, "tracking");
+      break;
+  }
+  const double xi_norm = s.xi.norm();
+  if (s.mode != FollowerMode::kWaiting && xi_norm > s.xi_max) {
+    status.mergeSummary(DiagnosticStatus::ERROR, "relative error outside xi_max");
+  }
+  if (!inputs.measurement_rejection.empty()) {
+    status.mergeSummary(DiagnosticStatus::WARN,
+                        "rejecting measurements: " + inputs.measurement_rejection);
+  }
+  if (!inputs.leader_rejection.empty()) {
+    status.mergeSummary(DiagnosticStatus::WARN,
+                        "rejecting leader broadcasts: " + inputs.leader_rejection);
+  }
+  status.add("mode", toString(s.mode));
+  status.add("xi_norm (m)", xi_norm);
+  status.add("xi_max (m)", s.xi_max);
+  status.add("margin (m)", s.xi_max - xi_norm);
+  status.add("estimate_norm (m)", s.status.estimate_norm);
+  status.add("projection_active", s.status.projection_active);
+  status.add("command_saturated", s.status.command_saturated);
+  status.add("command_rate_limited", s.status.command_rate_limited);
+  status.add("acceleration_limit (m/s^2)", s.acceleration_limit);
+  status.add("jerk_limit (m/s^3)", s.jerk_limit);
+  status.add("tracker_enabled", s.tracker_enabled);
+  {
+    const std::lock_guard<std::mutex> lock(gain_mutex_);
+    status.add("tracker_gain", tracker_gain_);
+  }
+  status.add("rejected_measurements", inputs.rejected_measurements);
+  status.add("rejected_leader_broadcasts", inputs.rejected_leader_broadcasts);
+  status.add("measurement_age (s)", s.mode == FollowerMode::kWaiting ? -1.0 : s.measurement_age);
+  status.add("leader_age (s)", std::isinf(s.leader_age) ? -1.0 : s.leader_age);
+  status.add("time_jumps", s.time_jumps);
+  status.add("trigger", toString(options_.trigger));
+  status.add("control_loop", toString(options_.control_loop));
+  status.add("control_priority", options_.control_priority);
+  status.add("lock_memory", options_.lock_memory);
+  status.add("ticks", s.steps);
+  status.add("missed_periods", s.missed_periods);
+  status.add("late_periods", s.late_periods);
+  status.add("tick_delay (s)", s.tick_delay);
+  status.add("outputs_dropped", handoff_.dropped());
+}
+
+}  // namespace projection_collision_avoidance

@@ -1,0 +1,91 @@
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <mutex>
+#include <memory>
+#include <string>
+#include <thread>
+
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <ros/ros.h>
+
+#include "follower/FollowerInputs.hpp"
+#include "follower/FollowerOptions.hpp"
+#include "projection_collision_avoidance/Formation.hpp"
+#include "projection_collision_avoidance/node/FollowerCycle.hpp"
+#include "projection_collision_avoidance/rt/Handoff.hpp"
+
+namespace projection_collision_avoidance {
+
+/// The follower's outputs: from each FollowerCycleOutput it publishes `command`
+/// (AccelStamped), `broadcast` (its command as a LeaderBroadcast, for a follower behind it),
+/// `status` (FollowerStatus) and, every so many steps, `markers`; it updates the diagnostics and
+/// writes the log lines the cycle's events call for (mode changes, time jumps, stalls).
+///
+/// publish() does it on the calling thread (timer loop, measurement trigger). post() is for a
+/// real-time thread: it copies the output into a preallocated lock-free queue and rings a
+/// doorbell, allocating and blocking on nothing; the outputs' own thread (started by
+/// startThread()) publishes from there. A full queue drops the output and counts it (dropped()).
+class FollowerOutputs {
+ public:
+  /// Outputs a real-time thread may get ahead of the publishing thread by.
+  static constexpr std::size_t kQueueCapacity = 64;
+
+  /// @param control_rate Hz, for the marker rate
+  FollowerOutputs(ros::NodeHandle nh, ros::NodeHandle private_nh, std::string node_name,
+                  const FollowerNodeOptions& options, double control_rate,
+                  const FormationMember& member, const Eigen::VectorXd& separation,
+                  const FollowerInputs* inputs);
+  ~FollowerOutputs();
+  FollowerOutputs(const FollowerOutputs&) = delete;
+  FollowerOutputs& operator=(const FollowerOutputs&) = delete;
+
+  /// Publishes @p out now, on this thread.
+  void publish(const FollowerCycleOutput& out);
+  /// Queues @p out for the outputs' thread (real-time safe).
+  void post(const FollowerCycleOutput& out) { handoff_.post(out); }
+  /// Starts the thread that publishes what post() queues; also runs @p idle (for example
+  /// collecting retired controllers) at least every 100 ms.
+  void startThread(std::function<void()> idle);
+  /// Stops and joins that thread (publishing what is queued first).
+  void stopThread();
+  /// The inputs whose refusals the status and diagnostics report (set before the first output).
+  void setInputs(const FollowerInputs* inputs) { inputs_ = inputs; }
+  /// The tracker gain G_e in force, for the diagnostics (any thread).
+  void describeTrackerGain(const Eigen::MatrixXd& gain);
+  /// Outputs dropped because the queue was full.
+  std::uint64_t dropped() const { return handoff_.dropped(); }
+
+ private:
+  void run(const std::function<void()>& idle);
+  void logEvents(const FollowerCycleOutput& out);
+  void publishMarkers(const FollowerCycleOutput& out);
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
+
+  std::string name_;
+  FollowerNodeOptions options_;
+  FormationMember member_;
+  Eigen::VectorXd separation_;
+  const FollowerInputs* inputs_;
+  std::uint64_t steps_per_marker_ = 0;
+
+  FollowerCycleOutput latest_;  ///< the latest output published (diagnostics)
+  bool have_latest_ = false;
+  FollowerMode logged_mode_ = FollowerMode::kWaiting;
+  std::mutex gain_mutex_;
+  std::string tracker_gain_;
+
+  ros::Publisher command_publisher_;
+  ros::Publisher broadcast_publisher_;
+  ros::Publisher status_publisher_;
+  ros::Publisher marker_publisher_;
+  diagnostic_updater::Updater diagnostics_;
+
+  Handoff<FollowerCycleOutput, kQueueCapacity> handoff_;
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
+
+}  // namespace projection_collision_avoidance

@@ -1,0 +1,95 @@
+#include "follower/FollowerReconfigure.hpp"
+
+#include <cmath>
+#include <utility>
+
+#include "projection_collision_avoidance/ControllerDesign.hpp"
+#include "projection_collision_avoidance/ParameterError.hpp"
+#include "projection_collision_avoidance/RuntimeFollowerController.hpp"
+#include "projection_collision_avoidance/ros/RosParameters.hpp"
+
+namespace projection_collision_avoidance {
+
+FollowerReconfigure::FollowerReconfigure(ros::NodeHandle private_nh, std::string node_name,
+                                         const ControllerParameters& file_parameters,
+                                         FollowerCycle* cycle, FollowerOutputs* outputs)
+    : name_(std::move(node_name)),
+      file_parameters_(file_parameters),
+      parameters_(file_parameters),
+      cycle_(cycle),
+      outputs_(outputs),
+      server_(server_mutex_, private_nh) {
+  outputs_->describeTrackerGain(parameters_.tracker_gain);
+  applied_ = configOf(parameters_);
+  server_.updateConfig(applied_);
+  server_.setCallback(
+      [this](FollowerConfig& config, uint32_t level) { onReconfigure(config, level); });
+}
+
+FollowerConfig FollowerReconfigure::configOf(const ControllerParameters& parameters) {
+  FollowerConfig config;
+  config.tracker_enabled = parameters.tracker_enabled;
+  config.alpha = parameters.alpha;
+  config.epsilon = parameters.epsilon;
+  config.tracker_natural_frequency = 0.0;  // 0 keeps the configured G_e matrix
+  config.tracker_damping = 0.7;
+  return config;
+}
+
+void FollowerReconfigure::collectRetired() {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  cycle_->retired().reset();
+}
+
+void FollowerReconfigure::onReconfigure(FollowerConfig& config, uint32_t /*level*/) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  cycle_->retired().reset();
+  ControllerParameters candidate = parameters_;
+  candidate.tracker_enabled = config.tracker_enabled;
+  candidate.alpha = config.alpha;
+  candidate.epsilon = config.epsilon;
+  try {
+    for (const auto& [name, value] :
+         {std::pair<const char*, double>{"alpha", config.alpha}, {"epsilon", config.epsilon},
+          {"tracker_natural_frequency", config.tracker_natural_frequency},
+          {"tracker_damping", config.tracker_damping}}) {
+      if (!std::isfinite(value)) {
+        throw ParameterError(name, "must be finite, got " + std::to_string(value));
+      }
+    }
+    if (config.tracker_natural_frequency < 0.0) {
+      throw ParameterError("tracker_natural_frequency",
+                           "must be >= 0 (0: the scenario's gain), got " +
+                               std::to_string(config.tracker_natural_frequency));
+    }
+    if (config.tracker_natural_frequency > 0.0) {
+      if (!candidate.model.C.isIdentity(0.0)) {
+        throw ParameterError("tracker_natural_frequency", "needs C = identity");
+      }
+      const int axes = candidate.model.double_integrator_axes;
+      candidate.tracker_gain = doubleIntegratorGain(
+          Eigen::VectorXd::Constant(axes, config.tracker_natural_frequency),
+          Eigen::VectorXd::Constant(axes, config.tracker_damping), "tracker_natural_frequency");
+    } else {
+      candidate.tracker_gain = file_parameters_.tracker_gain;  // 0: the scenario file's gain
+    }
+    auto controller =
+        std::make_unique<RuntimeFollowerController>(ControllerDesign::create(candidate));
+    const double xi_max = controller->design().xi_max;
+    cycle_->offer(std::move(controller)).reset();  // an offer not yet adopted is superseded
+    parameters_ = candidate;
+    outputs_->describeTrackerGain(parameters_.tracker_gain);
+    ROS_INFO_STREAM(name_ << ": reconfigured: tracker " << (candidate.tracker_enabled ? "on" : "off")
+                          << ", alpha " << candidate.alpha << ", epsilon " << candidate.epsilon
+                          << ", tracker gain "
+                          << (config.tracker_natural_frequency > 0.0 ? "from the frequency"
+                                                                     : "of the scenario file")
+                          << ", xi_max " << xi_max << " m");
+    applied_ = config;
+  } catch (const ParameterError& error) {
+    ROS_ERROR_STREAM(name_ << ": reconfiguration refused, previous values kept: " << error.what());
+    config = applied_;
+  }
+}
+
+}  // namespace projection_collision_avoidance

@@ -1,0 +1,54 @@
+#include "follower/StatusMessage.hpp"
+
+#include "projection_collision_avoidance/ros/InputAdmission.hpp"
+#include "projection_collision_avoidance/ros/MessageConversions.hpp"
+
+namespace projection_collision_avoidance {
+
+FollowerStatus toStatusMsg(const FollowerCycleOutput& out, const FollowerInputStats& inputs,
+                           const FormationMember& member, const std::string& frame) {
+  const RuntimeFollowerStatus& s = out.status;
+  FollowerStatus msg;
+  msg.header.stamp = rosTimeOf(out.stamp_ns);
+  msg.header.frame_id = frame;
+  msg.formation_index = static_cast<uint32_t>(member.index);
+  msg.target = member.target_name;
+  msg.mode = static_cast<uint8_t>(out.mode);
+  msg.mode_name = toString(out.mode);
+  msg.fallback = s.fallback;
+  msg.measurement_fresh =
+      out.mode == FollowerMode::kTracking || out.mode == FollowerMode::kLeaderLost;
+  msg.measurement_age = out.measurement_age;
+  msg.rejected_measurements = static_cast<uint32_t>(inputs.rejected_measurements);
+  msg.leader_fresh = out.leader_fresh;
+  msg.rejected_leader_broadcasts = static_cast<uint32_t>(inputs.rejected_leader_broadcasts);
+  msg.xi = toStdVector(out.xi);
+  msg.xi_hat = toStdVector(s.estimate);
+  msg.xi_norm = out.xi.norm();
+  msg.xi_hat_norm = s.estimate_norm;
+  msg.xi_max = out.xi_max;
+  msg.xi_soft = out.xi_soft;
+  msg.margin = out.xi_max - msg.xi_norm;
+  msg.constraint = s.constraint_value;
+  msg.projection_active = s.projection_active;
+  msg.command_saturated = s.command_saturated;
+  msg.acceleration_limit = out.acceleration_limit;
+  msg.command_rate_limited = s.command_rate_limited;
+  msg.jerk_limit = out.jerk_limit;
+  msg.tracker_enabled = out.tracker_enabled;
+  msg.command = toStdVector(s.command);
+  msg.baseline_command = toStdVector(s.baseline_command);
+  msg.tracker_command = toStdVector(s.tracker_command);
+  msg.feedforward_command = toStdVector(s.feedforward_command);
+  msg.fallback_command = toStdVector(s.fallback_command);
+  msg.separation = out.distance;
+  msg.perimeter = out.perimeter;
+  msg.ticks = out.steps;
+  msg.missed_periods = out.missed_periods;
+  msg.late_periods = out.late_periods;
+  msg.tick_delay = out.tick_delay;
+  msg.time_jumps = out.time_jumps;
+  return msg;
+}
+
+}  // namespace projection_collision_avoidance

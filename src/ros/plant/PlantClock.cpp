@@ -1,0 +1,143 @@
+#include "plant/PlantClock.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <utility>
+
+namespace projection_collision_avoidance {
+namespace {
+
+/// A tick is due when the time is within this fraction of a period of it.
+constexpr double kTickTolerance = 1e-6;
+/// Wall seconds of ticks that one wall-timer callback may catch up.
+constexpr double kMaxCatchUp = 0.05;
+
+}  // namespace
+
+PlantClock::PlantClock(ros::NodeHandle nh, std::string node_name, const PlantNodeOptions& options,
+                       std::mutex* mutex, Tick tick, Stop stop, Jump jump)
+    : name_(std::move(node_name)),
+      options_(options),
+      mutex_(mutex),
+      tick_(std::move(tick)),
+      stop_(std::move(stop)),
+      jump_(std::move(jump)) {
+  if (options_.duration > 0.0) {
+    last_tick_ = std::lround(options_.duration * options_.rate);
+  }
+  if (options_.publish_clock) {
+    // The plant owns simulated time: it must not wait on ROS time (which stays 0 under
+    // use_sim_time until a /clock arrives), so it ticks on wall time.
+    started_ = true;
+    origin_ = ros::Time(0);
+    wall_origin_ = ros::WallTime::now();
+    rate_check_wall_ = wall_origin_;
+    wall_timer_ =
+        nh.createWallTimer(ros::WallDuration(1.0 / (options_.rate * options_.real_time_factor)),
+                           &PlantClock::onWallTick, this);
+  } else {
+    timer_ = nh.createTimer(ros::Duration(1.0 / options_.rate), &PlantClock::onRosTick, this);
+  }
+}
+
+ros::Time PlantClock::stampOf(long k) const {
+  const double offset_ns = static_cast<double>(k) * 1e9 / options_.rate;
+  ros::Time stamp;
+  stamp.fromNSec(origin_.toNSec() + static_cast<uint64_t>(std::llround(offset_ns)));
+  return stamp;
+}
+
+ros::Time PlantClock::now() const {
+  return started_ ? stampOf(std::max(0L, next_tick_ - 1)) : ros::Time::now();
+}
+
+void PlantClock::halt() {
+  running_ = false;
+  wall_timer_.stop();
+  timer_.stop();
+}
+
+void PlantClock::runThrough(long due) {
+  while (running_ && next_tick_ <= due) {
+    running_ = tick_(next_tick_);
+    ++next_tick_;
+  }
+}
+
+void PlantClock::onWallTick(const ros::WallTimerEvent& /*event*/) {
+  const std::lock_guard<std::mutex> lock(*mutex_);
+  if (!running_) {
+    return;
+  }
+  // Tick k is due at wall time wall_origin_ + k / (rate * real_time_factor). A callback that
+  // runs late catches up the ticks due since (at most kMaxCatchUp s of them at once), so that
+  // simulated time keeps the real-time factor on average; a backlog beyond that is dropped
+  // (simulated time slows down) and reported below.
+  const double wall_rate = options_.rate * options_.real_time_factor;
+  const ros::WallTime now = ros::WallTime::now();
+  long due =
+      static_cast<long>(std::floor((now - wall_origin_).toSec() * wall_rate + kTickTolerance));
+  const long max_catch_up = std::max(1L, std::lround(kMaxCatchUp * wall_rate));
+  if (due - next_tick_ >= max_catch_up) {
+    due = next_tick_;
+    wall_origin_ = now - ros::WallDuration(static_cast<double>(next_tick_) / wall_rate);
+  }
+  runThrough(due);
+  // Report, at most every 5 s, a simulation slower than the real-time factor asked for.
+  const double wall = (now - rate_check_wall_).toSec();
+  if (wall >= 5.0) {
+    const double factor = static_cast<double>(next_tick_ - rate_check_tick_) / options_.rate / wall;
+    if (factor < 0.9 * options_.real_time_factor) {
+      ROS_WARN_STREAM(name_ << ": simulating at " << factor << "x real time, below the "
+                            << options_.real_time_factor << "x asked for");
+    }
+    rate_check_wall_ = now;
+    rate_check_tick_ = next_tick_;
+  }
+}
+
+void PlantClock::onRosTick(const ros::TimerEvent& /*event*/) {
+  const std::lock_guard<std::mutex> lock(*mutex_);
+  try {
+    rosTick();
+  } catch (const std::exception& error) {
+    ROS_ERROR_STREAM_THROTTLE(5.0, name_ << ": tick failed: " << error.what());
+  }
+}
+
+void PlantClock::rosTick() {
+  const ros::Time now = ros::Time::now();
+  if (!running_ || now.isZero()) {
+    return;
+  }
+  if (clock_.wentBack(now)) {
+    ROS_WARN_STREAM(name_ << ": ROS time went back by " << -clock_.jump() << " s, to "
+                          << now.toSec() << " s; waiting for it to reach "
+                          << stampOf(next_tick_).toSec() << " s again");
+    jump_(clock_.jump());
+  }
+  if (!started_) {
+    // Under use_sim_time scenario time is ROS time; otherwise it starts at the first tick.
+    started_ = true;
+    origin_ = ros::Time::isSimTime() ? ros::Time(0) : now;
+    next_tick_ = static_cast<long>(
+        std::ceil(secondsBetween(now, origin_) * options_.rate - kTickTolerance));
+    if (last_tick_ >= 0 && next_tick_ > last_tick_) {
+      std::ostringstream why;
+      why << "ROS time " << now.toSec() << " s is already past ~duration = " << options_.duration
+          << " s";
+      stop_(why.str());
+      return;
+    }
+  }
+  const long due = static_cast<long>(
+      std::floor(secondsBetween(now, origin_) * options_.rate + kTickTolerance));
+  if (due < next_tick_ - 1) {
+    return;  // ROS time went back: wait for it to reach the next tick again
+  }
+  // Catch up every due tick, at most one second of them per call.
+  runThrough(std::min(due, next_tick_ + std::max(1L, std::lround(options_.rate))));
+}
+
+}  // namespace projection_collision_avoidance

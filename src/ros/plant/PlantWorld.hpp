@@ -1,0 +1,113 @@
+#pragma once
+
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <geometry_msgs/AccelStamped.h>
+#include <ros/ros.h>
+#include <tf2_ros/transform_broadcaster.h>
+
+#include "projection_collision_avoidance/AgentIntegrator.hpp"
+#include "projection_collision_avoidance/RelativeMeasurement.h"
+#include "projection_collision_avoidance/Scenario.hpp"
+#include "projection_collision_avoidance/ros/InputAdmission.hpp"
+#include "projection_collision_avoidance/ros/InputGuard.hpp"
+#include "projection_collision_avoidance/ros/RosParameters.hpp"
+#include "projection_collision_avoidance/sim/MeasurementChannel.hpp"
+#include "plant/PlantClock.hpp"
+#include "plant/PlantOptions.hpp"
+
+namespace projection_collision_avoidance {
+
+/// The simulated world: the leader and its followers, double integrators integrated exactly by
+/// AgentIntegrator with the commands held between ticks and the leader's disturbance u_d applied
+/// exactly, as cf_sim does. The followers are the scenario's formation (layoutFormation()): one
+/// named `follower` (tf frame ~follower_frame) without a formation section, else `follower_<i>`
+/// (frame of the same name), i = 1 .. N, each measured relative to its target.
+///
+/// Subscribes `leader/command` and `<follower>/command` (geometry_msgs/AccelStamped; each held
+/// until replaced, and taken as zero once older than command_timeout; a command that is
+/// non-finite, acts on an axis the model lacks, is not in the agent's frame, is stamped more
+/// than command_timeout ahead of the plant's time or before the last accepted one is rejected,
+/// counted and warned about once per kind). At each tick t_k = k / rate it publishes
+/// `leader/odom`, `<follower>/odom` (nav_msgs/Odometry), tf world -> each agent's frame,
+/// `<follower>/relative_measurement` (RelativeMeasurement of x_target - x_i with noise, dropout,
+/// latency and an optional outage), at most 20 Hz (of simulated time) `agent_markers`
+/// (visualization_msgs/MarkerArray: agents, names, and a line from each follower to its target)
+/// and, with publish_clock, /clock = t_k; then it integrates every agent to t_{k+1} and publishes
+/// the command it held over that step as `leader/applied_command` and
+/// `<follower>/applied_command`.
+///
+/// Time: PlantClock. With publish_clock the plant owns simulated time (stamps t_k from 0), ticking on a wall
+/// timer at rate * real_time_factor (catching up ticks that a late callback missed). Otherwise it
+/// ticks on ROS time, catching up every tick that is due; scenario time is ROS time under
+/// use_sim_time and the time since the first tick otherwise.
+class PlantWorld {
+ public:
+  /// @throws ParameterError naming the parameter when the scenario or an option is invalid
+  PlantWorld(ros::NodeHandle nh, ros::NodeHandle private_nh);
+
+ private:
+  /// One simulated vehicle and its command input.
+  struct Agent {
+    Agent(const std::string& agent_name, const std::string& tf_frame, const AgentModel& model,
+          double step, const Eigen::VectorXd& initial_state, const SignalProfile& disturbance,
+          double command_timeout);
+
+    std::string name;   ///< topic prefix: "leader", "follower"
+    std::string frame;  ///< tf frame; commands must carry it as frame_id
+    AgentIntegrator<GenericDimensions> integrator;
+    Eigen::VectorXd command;  ///< latest accepted command (m/s^2)
+    InputGuard command_guard;
+    bool command_timed_out = false;  ///< the last tick used zero for lack of a fresh command
+    ros::Subscriber command_subscriber;
+    ros::Publisher odom_publisher;
+    ros::Publisher applied_command_publisher;  ///< the command integrated over each tick
+  };
+
+  /// A follower: its agent, its target and its measurement topic.
+  struct Follower {
+    Agent agent;
+    int target = 0;  ///< 0: the leader; j: followers_[j - 1]
+    ros::Publisher measurement_publisher;
+  };
+
+  void onCommand(Agent* agent, const geometry_msgs::AccelStamped::ConstPtr& msg);
+  /// Samples, publishes and integrates tick k (mutex_ held); false once the duration is
+  /// reached (and then requests the shutdown).
+  bool tick(long k);
+  void publishMeasurement(int index, long k, const ros::Time& stamp);
+  /// Publishes the command the agent's tick k at time t (s) integrates, and integrates it.
+  void advanceAgent(Agent* agent, double t, const ros::Time& stamp);
+  void publishMarkers(const ros::Time& stamp);
+  /// The agent a follower is measured against.
+  const Agent& targetOf(const Follower& follower) const;
+  /// The held command, or zero when it is absent or older than command_timeout at @p now.
+  GenericDimensions::InputVector commandAt(Agent* agent, const ros::Time& now);
+  void stop(const std::string& why);
+
+  ros::NodeHandle nh_;
+  std::string name_;
+  Scenario scenario_;
+  NodeOptionReader reader_;
+  PlantNodeOptions options_;
+  int axes_;
+
+  std::mutex mutex_;  ///< guards everything below against concurrent callbacks (nodelets)
+  Agent leader_;
+  std::vector<Follower> followers_;  ///< in index order; never resized after the subscriptions
+  std::unique_ptr<MeasurementChannels> channels_;
+  long ticks_per_marker_ = 1;
+  long last_tick_ = -1;  ///< tick at the duration; -1 = run forever
+
+  ros::Publisher clock_publisher_;
+  ros::Publisher marker_publisher_;
+  tf2_ros::TransformBroadcaster tf_broadcaster_;
+  ros::WallTimer shutdown_timer_;
+  std::unique_ptr<PlantClock> clock_;  ///< started last
+};
+
+}  // namespace projection_collision_avoidance

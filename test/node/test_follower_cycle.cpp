@@ -1,0 +1,249 @@
+/// The follower's control cycle and its real-time hand-offs, without ROS: the control thread
+/// allocates and frees nothing over 10,000 ticks with every input and output in use; modes, time
+/// jumps and stalls; the lock-free slot, queue and doorbell.
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <memory>
+#include <thread>
+
+#include <gtest/gtest.h>
+
+#include "AllocationCounter.hpp"
+#include "TestScenarios.hpp"
+#include "projection_collision_avoidance/ControllerDesign.hpp"
+#include "projection_collision_avoidance/node/FollowerCycle.hpp"
+#include "projection_collision_avoidance/rt/Handoff.hpp"
+#include "projection_collision_avoidance/rt/LatestValue.hpp"
+
+namespace projection_collision_avoidance {
+namespace {
+
+constexpr std::int64_t kMs = 1000000;  // ns
+constexpr std::int64_t kStart = 1000 * 1000 * kMs;
+
+ControllerDesign run2Design() {
+  ControllerParameters p = testing::paperParameters();  // Run 2's controller
+  p.control_rate = 1000.0;
+  p.acceleration_limit = 6.0;
+  p.jerk_limit = 500.0;
+  return ControllerDesign::create(p);
+}
+
+std::unique_ptr<FollowerCycle> makeCycle(FollowerCycleSettings settings = {}) {
+  const ControllerDesign design = run2Design();
+  return std::make_unique<FollowerCycle>(std::make_unique<RuntimeFollowerController>(design),
+                                         design.parameters.separation, settings);
+}
+
+MeasurementSample measurementAt(std::int64_t stamp_ns, std::uint64_t sequence, double gap) {
+  MeasurementSample m;
+  m.stamp_ns = stamp_ns;
+  m.receipt_ns = stamp_ns;
+  m.sequence = sequence;
+  m.relative_state.setZero(2);
+  m.relative_state << gap, 0.0;
+  return m;
+}
+
+TEST(FollowerCycle, TheControlThreadAllocatesAndFreesNothing) {
+  FollowerCycleSettings settings;
+  settings.use_leader_input = true;
+  std::unique_ptr<FollowerCycle> cycle = makeCycle(settings);
+  Handoff<FollowerCycleOutput, 64> outputs;
+  constexpr int kTicks = 12000;
+  std::atomic<std::int64_t> clock{kStart};
+  std::atomic<bool> done{false};
+
+  // The subscriber's side: measurements (with a 1 s outage from tick 4000) and leader broadcasts.
+  std::thread inputs([&] {
+    std::uint64_t sequence = 0;
+    std::int64_t last = 0;
+    while (!done) {
+      const std::int64_t now = clock.load();
+      const bool outage = now > kStart + 4000 * kMs && now < kStart + 5000 * kMs;
+      if (now != last && !outage) {
+        cycle->measurement().write(measurementAt(now, ++sequence, 5.0 + 0.5 * std::sin(1e-9 * now)));
+        LeaderSample leader;
+        leader.stamp_ns = leader.receipt_ns = now;
+        leader.acceleration.setConstant(1, -0.5);
+        cycle->leader().write(leader);
+        last = now;
+      }
+      std::this_thread::yield();
+    }
+  });
+  // The publisher's side: takes every output (and would build messages from it).
+  long published = 0;
+  long steps_seen = 0;
+  std::thread publisher([&] {
+    FollowerCycleOutput out;
+    std::uint32_t seen = outputs.count();
+    while (!done || outputs.pop(&out)) {
+      while (outputs.pop(&out)) {
+        ++published;
+        steps_seen += out.stepped ? 1 : 0;
+      }
+      seen = outputs.wait(seen, 10 * kMs);
+    }
+  });
+
+  // The control thread: ticks, a reconfiguration adopted half way, every output handed off.
+  long allocations = -1;
+  long frees = -1;
+  std::unique_ptr<RuntimeFollowerController> offered =
+      std::make_unique<RuntimeFollowerController>(run2Design());
+  std::thread control([&] {
+    FollowerCycleOutput out;
+    const long allocations_before = testing::threadAllocationCount();
+    const long frees_before = testing::threadFreeCount();
+    for (int k = 1; k <= kTicks; ++k) {
+      const std::int64_t now = clock.fetch_add(kMs) + kMs;
+      if (k == 6000) {
+        cycle->offer(std::move(offered));  // built on another thread; adopted by a tick
+      }
+      cycle->tick(now, 0.0, 0, &out);
+      outputs.post(out);
+      std::this_thread::sleep_for(std::chrono::microseconds(50));
+    }
+    allocations = testing::threadAllocationCount() - allocations_before;
+    frees = testing::threadFreeCount() - frees_before;
+  });
+  control.join();
+  done = true;
+  outputs.wake();
+  inputs.join();
+  publisher.join();
+
+  EXPECT_EQ(allocations, 0);
+  EXPECT_EQ(frees, 0);
+  EXPECT_NE(cycle->retired(), nullptr);  // the reconfiguration was adopted
+  EXPECT_GE(published + static_cast<long>(outputs.dropped()), kTicks);
+  EXPECT_GE(steps_seen, 10000);
+}
+
+TEST(FollowerCycle, ModesFromTheInputsAges) {
+  std::unique_ptr<FollowerCycle> cycle = makeCycle();
+  FollowerCycleOutput out;
+  EXPECT_FALSE(cycle->tick(kStart, 0.0, 0, &out));
+  EXPECT_EQ(out.mode, FollowerMode::kWaiting);
+  cycle->measurement().write(measurementAt(kStart, 1, 5.0));
+  ASSERT_TRUE(cycle->tick(kStart + kMs, 0.0, 0, &out));
+  EXPECT_EQ(out.mode, FollowerMode::kTracking);
+  EXPECT_NEAR(out.measurement_age, 0.001, 1e-12);
+  EXPECT_NEAR(out.distance, 5.0, 1e-12);
+  // Older than the 0.5 s timeout: the braking fallback.
+  ASSERT_TRUE(cycle->tick(kStart + 600 * kMs, 0.0, 0, &out));
+  EXPECT_EQ(out.mode, FollowerMode::kMeasurementLost);
+  EXPECT_TRUE(out.status.fallback);
+}
+
+TEST(FollowerCycle, AJumpBackOfTimeInvalidatesTheOldTimelinesInputs) {
+  std::unique_ptr<FollowerCycle> cycle = makeCycle();
+  FollowerCycleOutput out;
+  cycle->measurement().write(measurementAt(kStart, 1, 5.0));
+  ASSERT_TRUE(cycle->tick(kStart + kMs, 0.0, 0, &out));
+  EXPECT_EQ(out.mode, FollowerMode::kTracking);
+  ASSERT_TRUE(cycle->tick(kStart - 100000 * kMs, 0.0, 0, &out));  // 100 s earlier
+  EXPECT_EQ(out.time_jumps, 1U);
+  EXPECT_LT(out.time_jump, -99.0);
+  EXPECT_EQ(out.mode, FollowerMode::kMeasurementLost);
+  EXPECT_TRUE(std::isinf(out.measurement_age));
+  cycle->measurement().write(measurementAt(kStart - 99999 * kMs, 2, 5.0));
+  ASSERT_TRUE(cycle->tick(kStart - 99998 * kMs, 0.0, 0, &out));
+  EXPECT_EQ(out.mode, FollowerMode::kTracking);
+  EXPECT_GE(out.measurement_age, 0.0);
+}
+
+TEST(FollowerCycle, AfterAStallItWaitsForTheInputSentMeanwhile) {
+  std::unique_ptr<FollowerCycle> cycle = makeCycle();
+  FollowerCycleOutput out;
+  cycle->measurement().write(measurementAt(kStart, 1, 5.0));
+  ASSERT_TRUE(cycle->tick(kStart + kMs, 0.0, 0, &out));
+  // 2 s late: no step until a new measurement, though the old one is 2 s old.
+  EXPECT_FALSE(cycle->tick(kStart + 2001 * kMs, 2.0, 199, &out));
+  EXPECT_GT(out.stall, 1.9);
+  EXPECT_EQ(out.missed_periods, 200U);
+  EXPECT_FALSE(cycle->tick(kStart + 2002 * kMs, 0.0, 0, &out));
+  cycle->measurement().write(measurementAt(kStart + 2002 * kMs, 2, 5.0));
+  ASSERT_TRUE(cycle->tick(kStart + 2003 * kMs, 0.0, 0, &out));
+  EXPECT_EQ(out.mode, FollowerMode::kTracking);
+  // Without a new measurement the wait ends after half the timeout: then the fallback.
+  EXPECT_FALSE(cycle->tick(kStart + 5000 * kMs, 2.0, 0, &out));
+  ASSERT_TRUE(cycle->tick(kStart + 5300 * kMs, 0.0, 0, &out));
+  EXPECT_EQ(out.mode, FollowerMode::kMeasurementLost);
+}
+
+TEST(FollowerCycle, TheMeasurementTriggerStepsOnMeasurementsAndBrakesOnTicks) {
+  FollowerCycleSettings settings;
+  settings.measurement_trigger = true;
+  std::unique_ptr<FollowerCycle> cycle = makeCycle(settings);
+  FollowerCycleOutput out;
+  cycle->measurement().write(measurementAt(kStart, 1, 5.0));
+  ASSERT_TRUE(cycle->stepOnMeasurement(kStart + 2 * kMs, 0, &out));
+  EXPECT_EQ(out.stamp_ns, kStart);
+  EXPECT_NEAR(out.tick_delay, 0.002, 1e-12);
+  EXPECT_FALSE(cycle->tick(kStart + 10 * kMs, 0.0, 0, &out));  // fresh: the tick only counts
+  ASSERT_TRUE(cycle->tick(kStart + 700 * kMs, 0.0, 0, &out));  // stale: it brakes
+  EXPECT_EQ(out.mode, FollowerMode::kMeasurementLost);
+}
+
+TEST(LatestValue, TheReaderGetsTheNewestCompleteValue) {
+  LatestValue<std::array<std::int64_t, 16>> slot;
+  std::atomic<bool> done{false};
+  std::thread writer([&] {
+    std::array<std::int64_t, 16> value{};
+    for (std::int64_t k = 1; k <= 200000; ++k) {
+      value.fill(k);
+      slot.write(value);
+    }
+    done = true;
+  });
+  std::int64_t last = 0;
+  long torn = 0;
+  while (!done || slot.read()) {
+    if (slot.read()) {
+      const auto& value = slot.value();
+      for (const std::int64_t entry : value) {
+        torn += entry != value[0] ? 1 : 0;
+      }
+      EXPECT_GE(value[0], last);
+      last = value[0];
+    }
+  }
+  writer.join();
+  slot.read();
+  EXPECT_EQ(torn, 0);
+  EXPECT_EQ(slot.value()[0], 200000);
+}
+
+TEST(Handoff, KeepsOrderDropsWhenFullAndWakesTheWorker) {
+  Handoff<int, 4> handoff;
+  for (int k = 1; k <= 6; ++k) {
+    handoff.post(k);
+  }
+  EXPECT_EQ(handoff.dropped(), 2U);
+  int item = 0;
+  for (int k = 1; k <= 4; ++k) {
+    ASSERT_TRUE(handoff.pop(&item));
+    EXPECT_EQ(item, k);
+  }
+  EXPECT_FALSE(handoff.pop(&item));
+  const std::uint32_t seen = handoff.count();
+  std::thread poster([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    handoff.post(7);
+  });
+  const auto start = std::chrono::steady_clock::now();
+  handoff.wait(seen, 5000 * kMs);  // woken by the post, long before the 5 s timeout
+  const auto waited = std::chrono::steady_clock::now() - start;
+  poster.join();
+  EXPECT_LT(waited, std::chrono::seconds(2));
+  ASSERT_TRUE(handoff.pop(&item));
+  EXPECT_EQ(item, 7);
+}
+
+}  // namespace
+}  // namespace projection_collision_avoidance
