@@ -91,18 +91,18 @@ void FollowerCycle::readInputs(std::int64_t now_ns) {
 
 bool FollowerCycle::tick(std::int64_t now_ns, double delay, std::uint32_t skipped,
                          FollowerCycleOutput* out) {
+  // Measurement trigger: a measurement's step may run right now, in its callback; the tick
+  // waits for it (the timer trigger never takes the lock).
   std::unique_lock<std::mutex> lock(trigger_mutex_, std::defer_lock);
-  out->stepped = false;
-  if (settings_.measurement_trigger && !lock.try_lock()) {
-    fillCounters(out);  // a measurement's step runs right now: nothing to brake for
-    return false;
+  if (settings_.measurement_trigger) {
+    lock.lock();
   }
+  out->stepped = false;
   time_jump_ = 0.0;
   stall_ = 0.0;
   if (have_latest_time_ && now_ns < latest_time_ns_) {
     ++time_jumps_;
     time_jump_ = kNanosecond * static_cast<double>(now_ns - latest_time_ns_);
-    resuming_ = false;
   }
   latest_time_ns_ = now_ns;
   have_latest_time_ = true;
@@ -122,14 +122,14 @@ bool FollowerCycle::tick(std::int64_t now_ns, double delay, std::uint32_t skippe
     if (measurement_.value().sequence == sequence_at_stall_ &&
         kNanosecond * static_cast<double>(now_ns - resumed_at_ns_) < grace) {
       addSaturated(&missed_periods_, skipped + 1);
-      fillCounters(out);
+      fillCounters(now_ns, out);
       return false;
     }
     resuming_ = false;
   }
   if (!settings_.measurement_trigger) {
     addSaturated(&missed_periods_, skipped);
-    return step(now_ns, delay, out);
+    return step(now_ns, now_ns, delay, out);
   }
   // Measurement trigger: the measurements run the steps while they are fresh; a tick only
   // brakes once they are stale.
@@ -137,9 +137,9 @@ bool FollowerCycle::tick(std::int64_t now_ns, double delay, std::uint32_t skippe
                      ageOf(now_ns, measurement_.value().stamp_ns,
                            measurement_.value().receipt_ns) <= settings_.measurement_timeout;
   if (ever_measured_ && !fresh) {
-    return step(now_ns, delay, out);
+    return step(now_ns, now_ns, delay, out);
   }
-  fillCounters(out);
+  fillCounters(now_ns, out);
   return false;
 }
 
@@ -150,15 +150,16 @@ bool FollowerCycle::stepOnMeasurement(std::int64_t now_ns, std::uint32_t skipped
   readInputs(now_ns);
   if (!have_measurement_) {
     out->stepped = false;
-    fillCounters(out);
+    fillCounters(now_ns, out);
     return false;
   }
   addSaturated(&missed_periods_, skipped);
   const MeasurementSample& m = measurement_.value();
-  return step(m.stamp_ns, kNanosecond * static_cast<double>(now_ns - m.stamp_ns), out);
+  return step(now_ns, m.stamp_ns, kNanosecond * static_cast<double>(now_ns - m.stamp_ns), out);
 }
 
-bool FollowerCycle::step(std::int64_t stamp_ns, double delay, FollowerCycleOutput* out) {
+bool FollowerCycle::step(std::int64_t now_ns, std::int64_t stamp_ns, double delay,
+                         FollowerCycleOutput* out) {
   FollowerInputAges ages;
   ages.have_measurement = ever_measured_;
   ages.measurement_age =
@@ -174,7 +175,7 @@ bool FollowerCycle::step(std::int64_t stamp_ns, double delay, FollowerCycleOutpu
   out->stepped = false;
   out->mode = mode_;
   if (mode_ == FollowerMode::kWaiting) {
-    fillCounters(out);
+    fillCounters(now_ns, out);
     return false;
   }
   ++steps_;
@@ -204,17 +205,12 @@ bool FollowerCycle::step(std::int64_t stamp_ns, double delay, FollowerCycleOutpu
   out->measurement_age = ages.measurement_age;
   out->leader_age = ages.leader_age;
   out->status = *status;
-  out->xi_max = design.xi_max;
-  out->xi_soft = design.xi_soft;
-  out->perimeter = design.perimeter;
-  out->acceleration_limit = design.parameters.acceleration_limit;
-  out->jerk_limit = design.parameters.jerk_limit;
-  out->tracker_enabled = design.parameters.tracker_enabled;
-  fillCounters(out);
+  fillCounters(now_ns, out);
   return true;
 }
 
-void FollowerCycle::fillCounters(FollowerCycleOutput* out) const {
+void FollowerCycle::fillCounters(std::int64_t now_ns, FollowerCycleOutput* out) const {
+  out->now_ns = now_ns;
   out->mode = mode_;
   out->missed_periods = missed_periods_;
   out->late_periods = late_periods_;
@@ -225,6 +221,13 @@ void FollowerCycle::fillCounters(FollowerCycleOutput* out) const {
   if (!out->stepped) {
     out->steps = steps_;
   }
+  const ControllerDesign& design = controller_->design();
+  out->xi_max = design.xi_max;
+  out->xi_soft = design.xi_soft;
+  out->perimeter = design.perimeter;
+  out->acceleration_limit = design.parameters.acceleration_limit;
+  out->jerk_limit = design.parameters.jerk_limit;
+  out->tracker_enabled = design.parameters.tracker_enabled;
 }
 
 }  // namespace projection_collision_avoidance

@@ -45,6 +45,7 @@ struct FollowerCycleSettings {
 struct FollowerCycleOutput {
   bool stepped = false;           ///< a control step ran (else: waiting, stalled, or a tick of the
                                   ///< measurement trigger while the measurement is fresh)
+  std::int64_t now_ns = 0;        ///< ROS time of the tick or measurement that gave this output
   std::int64_t stamp_ns = 0;      ///< the step's stamp: tick time, or the measurement's stamp
   std::uint64_t steps = 0;        ///< control steps run since start, this one included
   FollowerMode mode = FollowerMode::kWaiting;
@@ -54,6 +55,7 @@ struct FollowerCycleOutput {
   GenericDimensions::StateVector xi;  ///< x_target - x_i - d of the measurement used (m, m/s)
   double distance = 0.0;              ///< ||p_target - p_i|| of that measurement (m)
   RuntimeFollowerStatus status;       ///< the controller's step
+  // The design in force (filled with or without a step).
   double xi_max = 0.0;                ///< (1 - alpha) ||d|| in force (m)
   double xi_soft = 0.0;               ///< xi_max / sqrt(1 + epsilon) in force (m)
   double perimeter = 0.0;             ///< alpha ||d|| in force (m)
@@ -72,8 +74,8 @@ struct FollowerCycleOutput {
 /// slots the input side writes (measurement(), leader()), decides the mode from their ages,
 /// runs one step of the controller and fills a FollowerCycleOutput. Nothing in tick() or
 /// stepOnMeasurement() allocates, locks (except under the measurement trigger, whose steps
-/// run in the measurement's callback) or makes a system call, so that a real-time thread can run
-/// it.
+/// run in the measurement's callback, and a tick waits for a step running there) or makes a
+/// system call, so that a real-time thread can run it.
 ///
 /// Time: every call gives the ROS time `now_ns`. An input is valid while it was received at or
 /// before now (after a jump back of ROS time, those of the old timeline are not, so the follower
@@ -118,11 +120,12 @@ class FollowerCycle {
   const ControllerDesign& design() const { return controller_->design(); }
 
  private:
-  /// One control step stamped @p stamp_ns, @p delay s after it was due.
-  bool step(std::int64_t stamp_ns, double delay, FollowerCycleOutput* out);
+  /// One control step at ROS time @p now_ns, stamped @p stamp_ns, @p delay s after it was due.
+  bool step(std::int64_t now_ns, std::int64_t stamp_ns, double delay, FollowerCycleOutput* out);
   void readInputs(std::int64_t now_ns);
   void adoptOffered();
-  void fillCounters(FollowerCycleOutput* out) const;
+  /// The counters and the design in force into @p out (whether or not a step ran).
+  void fillCounters(std::int64_t now_ns, FollowerCycleOutput* out) const;
 
   std::unique_ptr<RuntimeFollowerController> controller_;
   std::atomic<RuntimeFollowerController*> offered_{nullptr};
