@@ -111,6 +111,8 @@ PlantWorld::PlantWorld(ros::NodeHandle nh, ros::NodeHandle private_nh)
     }
     clock_publisher_ = nh_.advertise<rosgraph_msgs::Clock>("/clock", 10);
   }
+  // The clock's timers run their callbacks under mutex_: none before clock_ is set.
+  const std::lock_guard<std::mutex> lock(mutex_);
   clock_ = std::make_unique<PlantClock>(
       nh_, name_, options_, &mutex_, [this](long k) { return tick(k); },
       [this](const std::string& why) { stop(why); },
@@ -181,7 +183,7 @@ bool PlantWorld::tick(long k) {
         toOdometryMsg(state, stamp, options_.world_frame, follower.agent.frame));
     transforms.push_back(
         toTransformMsg(state.head(axes_), stamp, options_.world_frame, follower.agent.frame));
-    publishMeasurement(static_cast<int>(i), k, stamp);
+    publishMeasurement(static_cast<int>(i), k);
   }
   tf_broadcaster_.sendTransform(transforms);
   if (k % ticks_per_marker_ == 0) {
@@ -213,7 +215,7 @@ void PlantWorld::advanceAgent(Agent* agent, double t, const ros::Time& stamp) {
   agent->integrator.advance(t, command);
 }
 
-void PlantWorld::publishMeasurement(int index, long k, const ros::Time& stamp) {
+void PlantWorld::publishMeasurement(int index, long k) {
   Follower& follower = followers_[static_cast<std::size_t>(index)];
   const Eigen::VectorXd relative =
       targetOf(follower).integrator.state() - follower.agent.integrator.state();

@@ -79,7 +79,8 @@ class PlantWorld {
   /// Samples, publishes and integrates tick k (mutex_ held); false once the duration is
   /// reached (and then requests the shutdown).
   bool tick(long k);
-  void publishMeasurement(int index, long k, const ros::Time& stamp);
+  /// Samples follower @p index's channel at tick k and publishes what is due.
+  void publishMeasurement(int index, long k);
   /// Publishes the command the agent's tick k at time t (s) integrates, and integrates it.
   void advanceAgent(Agent* agent, double t, const ros::Time& stamp);
   void publishMarkers(const ros::Time& stamp);
