@@ -50,20 +50,26 @@ FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh,
   settings.measurement_trigger = options.trigger == ControlTrigger::kMeasurement;
   const ControllerDesign start = design;
   cycle_ = std::make_unique<FollowerCycle>(std::move(controller), parameters.separation, settings);
-  outputs_ = std::make_unique<FollowerOutputs>(nh, private_nh, name, options,
-                                               parameters.control_rate, member,
-                                               parameters.separation, nullptr);
-  inputs_ = std::make_unique<FollowerInputs>(
-      nh, name, options, start, cycle_.get(),
-      [this](const FollowerCycleOutput& out) { outputs_->publish(out); });
-  outputs_->setInputs(inputs_.get());
-  reconfigure_ =
-      std::make_unique<FollowerReconfigure>(private_nh, name, parameters, cycle_.get(), outputs_.get());
-  if (options.control_loop == ControlLoop::kThread) {
-    outputs_->startThread([this] { reconfigure_->collectRetired(); });
+  try {
+    // The inputs subscribe once the outputs that a measurement's step uses are in place.
+    inputs_ = std::make_unique<FollowerInputs>(
+        name, options, start, cycle_.get(),
+        [this](const FollowerCycleOutput& out) { outputs_->publish(out); });
+    outputs_ = std::make_unique<FollowerOutputs>(nh, private_nh, name, options,
+                                                 parameters.control_rate, member,
+                                                 parameters.separation, inputs_.get());
+    inputs_->start(nh);
+    reconfigure_ = std::make_unique<FollowerReconfigure>(private_nh, name, parameters,
+                                                         cycle_.get(), outputs_.get());
+    if (options.control_loop == ControlLoop::kThread) {
+      outputs_->startThread([this] { reconfigure_->collectRetired(); });
+    }
+    loop_ = std::make_unique<FollowerLoop>(nh, name, options, parameters.control_rate,
+                                           cycle_.get(), outputs_.get());
+  } catch (...) {
+    stop();  // the parts already running, in the order the destructor stops them
+    throw;
   }
-  loop_ = std::make_unique<FollowerLoop>(nh, options, parameters.control_rate, cycle_.get(),
-                                         outputs_.get());
 
   std::ostringstream loop;
   if (options.control_loop == ControlLoop::kThread) {
@@ -82,13 +88,16 @@ FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh,
                        << " axes, xi_max " << start.xi_max << " m");
 }
 
-FollowerNode::~FollowerNode() {
+FollowerNode::~FollowerNode() { stop(); }
+
+void FollowerNode::stop() {
   loop_.reset();  // "thread": ends within one period (at most 10 ms) and a tick
   if (outputs_) {
     outputs_->stopThread();
   }
   reconfigure_.reset();
-  inputs_.reset();
+  inputs_.reset();  // no measurement's step after this
+  outputs_.reset();
 }
 
 }  // namespace projection_collision_avoidance

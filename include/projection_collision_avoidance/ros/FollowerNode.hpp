@@ -79,6 +79,8 @@ class FollowerNode {
 
  private:
   FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh, const Scenario& scenario);
+  /// Stops the loop, the outputs' thread, reconfiguration and the inputs, in that order.
+  void stop();
 
   std::unique_ptr<FollowerCycle> cycle_;
   std::unique_ptr<FollowerInputs> inputs_;

@@ -1,14 +1,15 @@
 #include "follower/FollowerInputs.hpp"
 
+#include <algorithm>
 #include <utility>
 
 #include "projection_collision_avoidance/ros/MessageConversions.hpp"
 
 namespace projection_collision_avoidance {
 
-FollowerInputs::FollowerInputs(ros::NodeHandle nh, std::string node_name,
-                               const FollowerNodeOptions& options, const ControllerDesign& design,
-                               FollowerCycle* cycle, StepSink on_step)
+FollowerInputs::FollowerInputs(std::string node_name, const FollowerNodeOptions& options,
+                               const ControllerDesign& design, FollowerCycle* cycle,
+                               StepSink on_step)
     : name_(std::move(node_name)),
       options_(options),
       design_(design),
@@ -24,13 +25,31 @@ FollowerInputs::FollowerInputs(ros::NodeHandle nh, std::string node_name,
   measurement_.relative_state.setZero(2 * axes_);
   leader_.acceleration.setZero(axes_);
   relative_state_ = Eigen::VectorXd::Zero(2 * axes_);
+}
+
+void FollowerInputs::start(ros::NodeHandle nh) {
   measurement_subscriber_ = nh.subscribe("relative_measurement", 10, &FollowerInputs::onMeasurement,
                                          this, ros::TransportHints().tcpNoDelay());
   leader_subscriber_ = nh.subscribe("leader_broadcast", 10, &FollowerInputs::onLeaderBroadcast, this);
 }
 
-FollowerInputStats FollowerInputs::stats() const {
+void FollowerInputs::Heard::note(std::int64_t stamp_ns, std::int64_t now_ns) {
+  receipt_ns.store(now_ns, std::memory_order_relaxed);
+  effective_ns.store(std::min(stamp_ns, now_ns), std::memory_order_relaxed);
+}
+
+double FollowerInputs::Heard::ageAt(std::int64_t now_ns) const {
+  const std::int64_t effective = effective_ns.load(std::memory_order_relaxed);
+  if (effective == kNone || receipt_ns.load(std::memory_order_relaxed) > now_ns) {
+    return -1.0;
+  }
+  return 1e-9 * static_cast<double>(now_ns - effective);
+}
+
+FollowerInputStats FollowerInputs::stats(std::int64_t now_ns) const {
   FollowerInputStats stats;
+  stats.measurement_age = measurement_heard_.ageAt(now_ns);
+  stats.leader_age = leader_heard_.ageAt(now_ns);
   stats.rejected_measurements = rejected_measurements_.load(std::memory_order_relaxed);
   stats.rejected_leader_broadcasts = rejected_leader_broadcasts_.load(std::memory_order_relaxed);
   const std::lock_guard<std::mutex> lock(reasons_mutex_);
@@ -39,21 +58,19 @@ FollowerInputStats FollowerInputs::stats() const {
   return stats;
 }
 
-bool FollowerInputs::admitHeader(InputGuard& guard, ClockWatch& clock,
+bool FollowerInputs::admitHeader(InputGuard& guard, ClockWatch& clock, Heard& heard,
                                  const std_msgs::Header& header, const ros::Time& now) {
   if (clock.wentBack(now)) {
     guard.restartTimeline();  // the control cycle notes and reports the jump itself
+    heard.effective_ns.store(Heard::kNone, std::memory_order_relaxed);
   }
   return checkHeader(guard, header, now);
 }
 
 void FollowerInputs::onMeasurement(const RelativeMeasurement::ConstPtr& msg) {
-  const std::int64_t previous_stamp = measurement_guard_.lastStamp();
-  const bool had_one = measurement_guard_.haveAccepted();
-  bool accepted = false;
   admitGuarded(measurement_guard_, name_, [&] {
     const ros::Time now = ros::Time::now();
-    if (!admitHeader(measurement_guard_, measurement_clock_, msg->header, now)) {
+    if (!admitHeader(measurement_guard_, measurement_clock_, measurement_heard_, msg->header, now)) {
       return;
     }
     std::string why;
@@ -62,34 +79,35 @@ void FollowerInputs::onMeasurement(const RelativeMeasurement::ConstPtr& msg) {
       return;
     }
     const std::int64_t stamp = nanosecondsOf(msg->header.stamp);
+    // Measurement trigger: the periods between this stamp and the last accepted one's.
+    const std::uint32_t skipped =
+        measurement_guard_.haveAccepted()
+            ? skippedPeriods(1e-9 * static_cast<double>(stamp - measurement_guard_.lastStamp()),
+                             design_.period)
+            : 0;
     measurement_guard_.accept(stamp, nanosecondsOf(now));
+    measurement_heard_.note(stamp, nanosecondsOf(now));
     measurement_.stamp_ns = stamp;
     measurement_.receipt_ns = nanosecondsOf(now);
     measurement_.sequence = measurement_guard_.accepted();
     measurement_.relative_state = relative_state_;
     cycle_->measurement().write(measurement_);
-    accepted = true;
     if (options_.trigger == ControlTrigger::kMeasurement) {
-      const std::uint32_t skipped =
-          had_one ? skippedPeriods(1e-9 * static_cast<double>(stamp - previous_stamp),
-                                   design_.period)
-                  : 0;
       cycle_->stepOnMeasurement(nanosecondsOf(now), skipped, &trigger_output_);
       on_step_(trigger_output_);
     }
   });
   rejected_measurements_.store(measurement_guard_.rejected(), std::memory_order_relaxed);
-  if (!accepted || !measurement_rejection_.empty()) {
+  if (measurement_rejection_ != measurement_guard_.lastRejection()) {  // only this thread writes it
     const std::lock_guard<std::mutex> lock(reasons_mutex_);
     measurement_rejection_ = measurement_guard_.lastRejection();
   }
 }
 
 void FollowerInputs::onLeaderBroadcast(const LeaderBroadcast::ConstPtr& msg) {
-  bool accepted = false;
   admitGuarded(leader_guard_, name_, [&] {
     const ros::Time now = ros::Time::now();
-    if (!admitHeader(leader_guard_, leader_clock_, msg->header, now)) {
+    if (!admitHeader(leader_guard_, leader_clock_, leader_heard_, msg->header, now)) {
       return;
     }
     std::string why;
@@ -101,15 +119,15 @@ void FollowerInputs::onLeaderBroadcast(const LeaderBroadcast::ConstPtr& msg) {
     }
     const std::int64_t stamp = nanosecondsOf(msg->header.stamp);
     leader_guard_.accept(stamp, nanosecondsOf(now));
+    leader_heard_.note(stamp, nanosecondsOf(now));
     leader_.stamp_ns = stamp;
     leader_.receipt_ns = nanosecondsOf(now);
     leader_.sequence = leader_guard_.accepted();
     leader_.acceleration = design_.leaderAcceleration(input, disturbance);
     cycle_->leader().write(leader_);
-    accepted = true;
   });
   rejected_leader_broadcasts_.store(leader_guard_.rejected(), std::memory_order_relaxed);
-  if (!accepted || !leader_rejection_.empty()) {
+  if (leader_rejection_ != leader_guard_.lastRejection()) {  // only this thread writes it
     const std::lock_guard<std::mutex> lock(reasons_mutex_);
     leader_rejection_ = leader_guard_.lastRejection();
   }

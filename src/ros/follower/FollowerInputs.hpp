@@ -18,19 +18,22 @@
 
 namespace projection_collision_avoidance {
 
-/// What the inputs have refused so far, for the status and the diagnostics.
+/// What the inputs have refused so far, and the ages of what they accepted, for the status and
+/// the diagnostics.
 struct FollowerInputStats {
   std::uint64_t rejected_measurements = 0;
   std::uint64_t rejected_leader_broadcasts = 0;
   std::string measurement_rejection;  ///< the latest, "" once one was accepted after it
   std::string leader_rejection;
+  double measurement_age = -1.0;  ///< s, of the last accepted measurement; -1: none on this timeline
+  double leader_age = -1.0;       ///< s, of the last accepted leader broadcast; -1: none
 };
 
 /// The follower's inputs: subscribes `relative_measurement` and `leader_broadcast`, judges each
 /// message with its InputGuard (doc/boundary.md) on the subscriber's thread, and writes what it
 /// accepts into the control cycle's lock-free slots. With ~trigger measurement, each accepted
 /// measurement runs the cycle's step at once and hands its output to @p on_step. Nothing a
-/// message carries can end the node (admitGuarded()).
+/// message carries can end the node (admitGuarded()). The subscriptions start with start().
 class FollowerInputs {
  public:
   using StepSink = std::function<void(const FollowerCycleOutput&)>;
@@ -38,19 +41,33 @@ class FollowerInputs {
   /// @param design the design at start: its model sizes and leader acceleration (pinv(B) u_d),
   ///        which reconfiguration does not change
   /// @param cycle where accepted inputs go; outlives this object
-  FollowerInputs(ros::NodeHandle nh, std::string node_name, const FollowerNodeOptions& options,
+  FollowerInputs(std::string node_name, const FollowerNodeOptions& options,
                  const ControllerDesign& design, FollowerCycle* cycle, StepSink on_step);
 
-  /// Refusal counts and latest reasons (any thread).
-  FollowerInputStats stats() const;
+  /// Subscribes the inputs (once what the callbacks use is in place).
+  void start(ros::NodeHandle nh);
+
+  /// Refusal counts, latest reasons and the inputs' ages at ROS time @p now_ns (any thread).
+  FollowerInputStats stats(std::int64_t now_ns) const;
 
  private:
   void onMeasurement(const RelativeMeasurement::ConstPtr& msg);
   void onLeaderBroadcast(const LeaderBroadcast::ConstPtr& msg);
-  /// Notes a jump back of ROS time on this input's side (restarting @p guard's timeline), then
-  /// judges @p header at @p now.
-  static bool admitHeader(InputGuard& guard, ClockWatch& clock, const std_msgs::Header& header,
-                          const ros::Time& now);
+  /// One input's last accepted message, for its age: effective stamp min(stamp, receipt) and
+  /// receipt (ns); kNone when there is none on this timeline.
+  struct Heard {
+    static constexpr std::int64_t kNone = -1;
+    std::atomic<std::int64_t> effective_ns{kNone};
+    std::atomic<std::int64_t> receipt_ns{kNone};
+    /// A message stamped @p stamp_ns accepted at @p now_ns.
+    void note(std::int64_t stamp_ns, std::int64_t now_ns);
+    /// Age (s) at @p now_ns; -1 when none, or received after @p now_ns (an older timeline).
+    double ageAt(std::int64_t now_ns) const;
+  };
+  /// Notes a jump back of ROS time on this input's side (restarting @p guard's timeline and
+  /// forgetting @p heard), then judges @p header at @p now.
+  static bool admitHeader(InputGuard& guard, ClockWatch& clock, Heard& heard,
+                          const std_msgs::Header& header, const ros::Time& now);
 
   std::string name_;
   FollowerNodeOptions options_;
@@ -72,6 +89,8 @@ class FollowerInputs {
   // Read by other threads.
   std::atomic<std::uint64_t> rejected_measurements_{0};
   std::atomic<std::uint64_t> rejected_leader_broadcasts_{0};
+  Heard measurement_heard_;
+  Heard leader_heard_;
   mutable std::mutex reasons_mutex_;
   std::string measurement_rejection_;
   std::string leader_rejection_;

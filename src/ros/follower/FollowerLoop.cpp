@@ -5,15 +5,21 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <utility>
 
 #include "projection_collision_avoidance/ParameterError.hpp"
 #include "projection_collision_avoidance/ros/InputAdmission.hpp"
 
 namespace projection_collision_avoidance {
 
-FollowerLoop::FollowerLoop(ros::NodeHandle nh, const FollowerNodeOptions& options,
-                           double control_rate, FollowerCycle* cycle, FollowerOutputs* outputs)
-    : cycle_(cycle), outputs_(outputs), period_(1.0 / control_rate) {
+FollowerLoop::FollowerLoop(ros::NodeHandle nh, std::string node_name,
+                           const FollowerNodeOptions& options, double control_rate,
+                           FollowerCycle* cycle, FollowerOutputs* outputs)
+    : name_(std::move(node_name)),
+      count_timer_periods_(options.trigger == ControlTrigger::kTimer),
+      cycle_(cycle),
+      outputs_(outputs),
+      period_(1.0 / control_rate) {
   if (options.control_loop == ControlLoop::kThread) {
     const int priority = options.control_priority;
     try {
@@ -45,17 +51,23 @@ FollowerLoop::~FollowerLoop() {
 
 void FollowerLoop::onTimer(const ros::TimerEvent& event) {
   try {
+    const ros::Time now = ros::Time::now();
+    if (clock_.wentBack(now)) {
+      have_last_expected_ = false;  // the expected times of the old timeline do not count
+    }
     const double delay = secondsBetween(event.current_real, event.current_expected);
     std::uint32_t skipped = 0;
-    if (have_last_expected_ && event.current_expected > last_expected_) {
-      skipped = skippedPeriods(secondsBetween(event.current_expected, last_expected_), period_);
+    if (count_timer_periods_) {
+      if (have_last_expected_) {
+        skipped = skippedPeriods(secondsBetween(event.current_expected, last_expected_), period_);
+      }
+      last_expected_ = event.current_expected;
+      have_last_expected_ = true;
     }
-    last_expected_ = event.current_expected;
-    have_last_expected_ = true;
-    cycle_->tick(nanosecondsOf(ros::Time::now()), delay, skipped, &timer_output_);
+    cycle_->tick(nanosecondsOf(now), delay, skipped, &timer_output_);
     outputs_->publish(timer_output_);
   } catch (const std::exception& error) {
-    ROS_ERROR_STREAM_THROTTLE(5.0, "control tick failed: " << error.what());
+    ROS_ERROR_STREAM_THROTTLE(5.0, name_ << ": control tick failed: " << error.what());
   }
 }
 
@@ -63,11 +75,15 @@ void FollowerLoop::onThreadTick(const PeriodicTick& tick) {
   if (!ros::ok()) {  // shutting down: the timer's spinner would not call it either
     return;
   }
-  const double delay = 1e-9 * static_cast<double>(tick.actual - tick.expected);
-  const std::uint64_t most = std::numeric_limits<std::uint32_t>::max();
-  cycle_->tick(nanosecondsOf(ros::Time::now()), delay,
-               static_cast<std::uint32_t>(std::min(tick.skipped, most)), &thread_output_);
-  outputs_->post(thread_output_);
+  try {
+    const double delay = 1e-9 * static_cast<double>(tick.actual - tick.expected);
+    const std::uint64_t most = std::numeric_limits<std::uint32_t>::max();
+    cycle_->tick(nanosecondsOf(ros::Time::now()), delay,
+                 static_cast<std::uint32_t>(std::min(tick.skipped, most)), &thread_output_);
+    outputs_->post(thread_output_);
+  } catch (const std::exception& error) {
+    ROS_ERROR_STREAM_THROTTLE(5.0, name_ << ": control tick failed: " << error.what());
+  }
 }
 
 }  // namespace projection_collision_avoidance

@@ -2,6 +2,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <string>
 
 #include <ros/callback_queue.h>
 #include <ros/ros.h>
@@ -9,6 +10,7 @@
 #include "follower/FollowerOptions.hpp"
 #include "follower/FollowerOutputs.hpp"
 #include "projection_collision_avoidance/node/FollowerCycle.hpp"
+#include "projection_collision_avoidance/ros/InputAdmission.hpp"
 #include "projection_collision_avoidance/ros/RealtimeLoop.hpp"
 
 namespace projection_collision_avoidance {
@@ -17,8 +19,8 @@ namespace projection_collision_avoidance {
 ///
 /// "timer": a ros::Timer (ROS time; simulated time works) on a callback queue and spinner thread
 /// of their own, so that a flood of input messages cannot delay a tick; the tick publishes on
-/// that thread. Missed periods: the timer's expected times more than 1.5 periods apart count
-/// round(gap / T) - 1.
+/// that thread. Missed periods (~trigger timer): the timer's expected times more than 1.5
+/// periods apart count round(gap / T) - 1.
 ///
 /// "thread": a PeriodicThread sleeping to absolute CLOCK_MONOTONIC deadlines k T, optionally
 /// under SCHED_FIFO (~control_priority), stamped with ros::Time::now() (wall time only). Its tick
@@ -29,8 +31,9 @@ class FollowerLoop {
  public:
   /// Starts the loop at @p control_rate Hz.
   /// @throws ParameterError naming ~control_priority when the kernel refuses the priority
-  FollowerLoop(ros::NodeHandle nh, const FollowerNodeOptions& options, double control_rate,
-               FollowerCycle* cycle, FollowerOutputs* outputs);
+  /// @param node_name prefix of the log lines
+  FollowerLoop(ros::NodeHandle nh, std::string node_name, const FollowerNodeOptions& options,
+               double control_rate, FollowerCycle* cycle, FollowerOutputs* outputs);
   /// Stops the loop (the thread within one period, at most 10 ms, and a running tick).
   ~FollowerLoop();
   FollowerLoop(const FollowerLoop&) = delete;
@@ -40,11 +43,14 @@ class FollowerLoop {
   void onTimer(const ros::TimerEvent& event);
   void onThreadTick(const PeriodicTick& tick);
 
+  std::string name_;
+  bool count_timer_periods_;  ///< ~trigger timer: the timer's skipped periods are missed
   FollowerCycle* cycle_;
   FollowerOutputs* outputs_;
   double period_;
   FollowerCycleOutput timer_output_;   ///< the timer thread's
   FollowerCycleOutput thread_output_;  ///< the control thread's
+  ClockWatch clock_;  ///< jumps back of ROS time at the timer's ticks
   ros::Time last_expected_;
   bool have_last_expected_ = false;
   ros::CallbackQueue queue_;

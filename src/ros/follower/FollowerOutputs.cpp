@@ -8,13 +8,14 @@
 #include <geometry_msgs/AccelStamped.h>
 #include <visualization_msgs/MarkerArray.h>
 
+#include "follower/StatusMessage.hpp"
 #include "projection_collision_avoidance/FollowerStatus.h"
 #include "projection_collision_avoidance/LeaderBroadcast.h"
-#include "follower/StatusMessage.hpp"
 #include "projection_collision_avoidance/ros/InputAdmission.hpp"
 #include "projection_collision_avoidance/ros/MessageConversions.hpp"
 
 namespace projection_collision_avoidance {
+
 FollowerOutputs::FollowerOutputs(ros::NodeHandle nh, ros::NodeHandle private_nh,
                                  std::string node_name, const FollowerNodeOptions& options,
                                  double control_rate, const FormationMember& member,
@@ -40,10 +41,32 @@ FollowerOutputs::FollowerOutputs(ros::NodeHandle nh, ros::NodeHandle private_nh,
 
 FollowerOutputs::~FollowerOutputs() { stopThread(); }
 
+void FollowerOutputs::remember(const FollowerCycleOutput& out) {
+  if (out.stepped) {
+    latest_ = out;
+    return;
+  }
+  latest_.now_ns = out.now_ns;
+  latest_.steps = out.steps;
+  latest_.mode = out.mode;
+  latest_.xi_max = out.xi_max;
+  latest_.xi_soft = out.xi_soft;
+  latest_.perimeter = out.perimeter;
+  latest_.acceleration_limit = out.acceleration_limit;
+  latest_.jerk_limit = out.jerk_limit;
+  latest_.tracker_enabled = out.tracker_enabled;
+  latest_.missed_periods = out.missed_periods;
+  latest_.late_periods = out.late_periods;
+  latest_.tick_delay = out.tick_delay;
+  latest_.time_jumps = out.time_jumps;
+  latest_.time_jump = out.time_jump;
+  latest_.stall = out.stall;
+}
+
 void FollowerOutputs::publish(const FollowerCycleOutput& out) {
+  const std::lock_guard<std::mutex> lock(publish_mutex_);
   logEvents(out);
-  latest_ = out;
-  have_latest_ = true;
+  remember(out);
   if (out.stepped) {
     const ros::Time stamp = rosTimeOf(out.stamp_ns);
     command_publisher_.publish(toAccelMsg(out.status.command, stamp, options_.follower_frame));
@@ -52,7 +75,8 @@ void FollowerOutputs::publish(const FollowerCycleOutput& out) {
     broadcast.header.frame_id = options_.follower_frame;
     broadcast.input = toStdVector(out.status.command);
     broadcast_publisher_.publish(broadcast);
-    status_publisher_.publish(toStatusMsg(out, inputs_->stats(), member_, options_.follower_frame));
+    status_publisher_.publish(
+        toStatusMsg(out, inputs_->stats(out.now_ns), member_, options_.follower_frame));
     if (steps_per_marker_ > 0 && (out.steps - 1) % steps_per_marker_ == 0) {
       publishMarkers(out);
     }
@@ -102,7 +126,8 @@ void FollowerOutputs::run(const std::function<void()>& idle) {
 
 void FollowerOutputs::logEvents(const FollowerCycleOutput& out) {
   if (out.time_jump < 0.0) {
-    ROS_WARN_STREAM(name_ << ": ROS time went back by " << -out.time_jump
+    ROS_WARN_STREAM(name_ << ": ROS time went back by " << -out.time_jump << " s, to "
+                          << rosTimeOf(out.now_ns).toSec()
                           << " s: the inputs of the old timeline are forgotten; braking until "
                              "fresh measurements arrive");
   }
@@ -136,9 +161,10 @@ void FollowerOutputs::logEvents(const FollowerCycleOutput& out) {
 }
 
 void FollowerOutputs::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  // Called from publish() (diagnostics_.update()) with publish_mutex_ held.
   using diagnostic_msgs::DiagnosticStatus;
   const FollowerCycleOutput& s = latest_;
-  const FollowerInputStats inputs = inputs_->stats();
+  const FollowerInputStats inputs = inputs_->stats(nanosecondsOf(ros::Time::now()));
   switch (s.mode) {
     case FollowerMode::kWaiting:
       status.summary(DiagnosticStatus::ERROR, "no relative measurement yet");
@@ -172,8 +198,8 @@ void FollowerOutputs::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat
   status.add("estimate_norm (m)", s.status.estimate_norm);
   status.add("projection_active", s.status.projection_active);
   status.add("command_saturated", s.status.command_saturated);
-  status.add("command_rate_limited", s.status.command_rate_limited);
   status.add("acceleration_limit (m/s^2)", s.acceleration_limit);
+  status.add("command_rate_limited", s.status.command_rate_limited);
   status.add("jerk_limit (m/s^3)", s.jerk_limit);
   status.add("tracker_enabled", s.tracker_enabled);
   {
@@ -182,8 +208,8 @@ void FollowerOutputs::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat
   }
   status.add("rejected_measurements", inputs.rejected_measurements);
   status.add("rejected_leader_broadcasts", inputs.rejected_leader_broadcasts);
-  status.add("measurement_age (s)", s.mode == FollowerMode::kWaiting ? -1.0 : s.measurement_age);
-  status.add("leader_age (s)", std::isinf(s.leader_age) ? -1.0 : s.leader_age);
+  status.add("measurement_age (s)", inputs.measurement_age);
+  status.add("leader_age (s)", inputs.leader_age);
   status.add("time_jumps", s.time_jumps);
   status.add("trigger", toString(options_.trigger));
   status.add("control_loop", toString(options_.control_loop));
@@ -193,7 +219,6 @@ void FollowerOutputs::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat
   status.add("missed_periods", s.missed_periods);
   status.add("late_periods", s.late_periods);
   status.add("tick_delay (s)", s.tick_delay);
-  status.add("outputs_dropped", handoff_.dropped());
 }
 
 }  // namespace projection_collision_avoidance

@@ -24,7 +24,8 @@ namespace projection_collision_avoidance {
 /// `status` (FollowerStatus) and, every so many steps, `markers`; it updates the diagnostics and
 /// writes the log lines the cycle's events call for (mode changes, time jumps, stalls).
 ///
-/// publish() does it on the calling thread (timer loop, measurement trigger). post() is for a
+/// publish() does it on the calling thread (timer loop, measurement trigger; one call at a time).
+/// post() is for a
 /// real-time thread: it copies the output into a preallocated lock-free queue and rings a
 /// doorbell, allocating and blocking on nothing; the outputs' own thread (started by
 /// startThread()) publishes from there. A full queue drops the output and counts it (dropped()).
@@ -34,6 +35,7 @@ class FollowerOutputs {
   static constexpr std::size_t kQueueCapacity = 64;
 
   /// @param control_rate Hz, for the marker rate
+  /// @param inputs the inputs whose refusals and ages the status and diagnostics report
   FollowerOutputs(ros::NodeHandle nh, ros::NodeHandle private_nh, std::string node_name,
                   const FollowerNodeOptions& options, double control_rate,
                   const FormationMember& member, const Eigen::VectorXd& separation,
@@ -51,11 +53,10 @@ class FollowerOutputs {
   void startThread(std::function<void()> idle);
   /// Stops and joins that thread (publishing what is queued first).
   void stopThread();
-  /// The inputs whose refusals the status and diagnostics report (set before the first output).
-  void setInputs(const FollowerInputs* inputs) { inputs_ = inputs; }
   /// The tracker gain G_e in force, for the diagnostics (any thread).
   void describeTrackerGain(const Eigen::MatrixXd& gain);
-  /// Outputs dropped because the queue was full.
+  /// Outputs dropped because the queue was full (a queue this size never fills at the control
+  /// rates of a follower, ~1 kHz at most, unless the publishing thread stands still).
   std::uint64_t dropped() const { return handoff_.dropped(); }
 
  private:
@@ -71,10 +72,12 @@ class FollowerOutputs {
   const FollowerInputs* inputs_;
   std::uint64_t steps_per_marker_ = 0;
 
-  FollowerCycleOutput latest_;  ///< the latest output published (diagnostics)
-  bool have_latest_ = false;
+  std::mutex publish_mutex_;     ///< publish(): the timer's or outputs' thread vs a measurement's
+  FollowerCycleOutput latest_;  ///< the latest step, with the counters of the latest output
+  /// Keeps the latest step's results in latest_ and takes the counters and design of @p out.
+  void remember(const FollowerCycleOutput& out);
   FollowerMode logged_mode_ = FollowerMode::kWaiting;
-  std::mutex gain_mutex_;
+  std::mutex gain_mutex_;  ///< tracker_gain_: set by reconfiguration
   std::string tracker_gain_;
 
   ros::Publisher command_publisher_;
