@@ -68,7 +68,7 @@ struct Scenario;
 /// step; no ROS), FollowerLoop (the timer or real-time thread that ticks the cycle),
 /// FollowerOutputs (messages, markers, diagnostics, log lines; a thread of its own behind a
 /// lock-free queue for the real-time loop) and FollowerReconfigure (dynamic_reconfigure). This
-/// class reads the parameters and wires them (doc/architecture.md).
+/// class reads the parameters and wires them (doc/layout.md).
 class FollowerNode {
  public:
   /// @throws ParameterError naming the parameter when the scenario or an option is invalid
