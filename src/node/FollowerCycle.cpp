@@ -133,9 +133,9 @@ bool FollowerCycle::tick(std::int64_t now_ns, double delay, std::uint32_t skippe
   }
   // Measurement trigger: the measurements run the steps while they are fresh; a tick only
   // brakes once they are stale.
-  const bool fresh = have_measurement_ &&
-                     ageOf(now_ns, measurement_.value().stamp_ns,
-                           measurement_.value().receipt_ns) <= settings_.measurement_timeout;
+  const bool fresh =
+      have_measurement_ && ageOf(now_ns, measurement_.value().stamp_ns,
+                                 measurement_.value().receipt_ns) <= settings_.measurement_timeout;
   if (ever_measured_ && !fresh) {
     return step(now_ns, now_ns, delay, out);
   }
@@ -162,14 +162,13 @@ bool FollowerCycle::step(std::int64_t now_ns, std::int64_t stamp_ns, double dela
                          FollowerCycleOutput* out) {
   FollowerInputAges ages;
   ages.have_measurement = ever_measured_;
-  ages.measurement_age =
-      have_measurement_ ? ageOf(stamp_ns, measurement_.value().stamp_ns,
-                                measurement_.value().receipt_ns)
-                        : std::numeric_limits<double>::infinity();
+  ages.measurement_age = have_measurement_ ? ageOf(stamp_ns, measurement_.value().stamp_ns,
+                                                   measurement_.value().receipt_ns)
+                                           : std::numeric_limits<double>::infinity();
   ages.have_leader = ever_led_;
-  ages.leader_age = have_leader_ ? ageOf(stamp_ns, leader_.value().stamp_ns,
-                                         leader_.value().receipt_ns)
-                                 : std::numeric_limits<double>::infinity();
+  ages.leader_age = have_leader_
+                        ? ageOf(stamp_ns, leader_.value().stamp_ns, leader_.value().receipt_ns)
+                        : std::numeric_limits<double>::infinity();
   mode_ = selectFollowerMode(
       ages, FollowerTimeouts{settings_.measurement_timeout, settings_.leader_timeout});
   out->stepped = false;
@@ -196,8 +195,8 @@ bool FollowerCycle::step(std::int64_t now_ns, std::int64_t stamp_ns, double dela
                         : &controller_->stepFallback();
   } else {
     y_.noalias() = design.parameters.model.C * out->xi;
-    status = use_leader ? &controller_->step(y_, leader_.value().acceleration)
-                        : &controller_->step(y_);
+    status =
+        use_leader ? &controller_->step(y_, leader_.value().acceleration) : &controller_->step(y_);
   }
   out->stepped = true;
   out->stamp_ns = stamp_ns;

@@ -3,16 +3,17 @@
 #include <sstream>
 #include <system_error>
 
-#include "follower/FollowerInputs.hpp"
-#include "follower/FollowerLoop.hpp"
-#include "follower/FollowerOptions.hpp"
-#include "follower/FollowerOutputs.hpp"
-#include "follower/FollowerReconfigure.hpp"
 #include "projection_collision_avoidance/ControllerDesign.hpp"
 #include "projection_collision_avoidance/ParameterError.hpp"
 #include "projection_collision_avoidance/RuntimeFollowerController.hpp"
 #include "projection_collision_avoidance/node/FollowerCycle.hpp"
 #include "projection_collision_avoidance/ros/RosParameters.hpp"
+
+#include "follower/FollowerInputs.hpp"
+#include "follower/FollowerLoop.hpp"
+#include "follower/FollowerOptions.hpp"
+#include "follower/FollowerOutputs.hpp"
+#include "follower/FollowerReconfigure.hpp"
 
 namespace projection_collision_avoidance {
 
@@ -24,7 +25,8 @@ FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh,
   NodeOptionReader reader(private_nh);
   const FormationMember member = memberOf(reader, scenario);
   const ControllerParameters parameters = memberParameters(scenario.controller, member);
-  auto controller = std::make_unique<RuntimeFollowerController>(ControllerDesign::create(parameters));
+  auto controller =
+      std::make_unique<RuntimeFollowerController>(ControllerDesign::create(parameters));
   const ControllerDesign& design = controller->design();
   const FollowerNodeOptions options =
       readFollowerOptions(reader, parameters, member, ros::Time::isSimTime());
@@ -55,17 +57,17 @@ FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh,
     inputs_ = std::make_unique<FollowerInputs>(
         name, options, start, cycle_.get(),
         [this](const FollowerCycleOutput& out) { outputs_->publish(out); });
-    outputs_ = std::make_unique<FollowerOutputs>(nh, private_nh, name, options,
-                                                 parameters.control_rate, member,
-                                                 parameters.separation, inputs_.get());
+    outputs_ =
+        std::make_unique<FollowerOutputs>(nh, private_nh, name, options, parameters.control_rate,
+                                          member, parameters.separation, inputs_.get());
     inputs_->start(nh);
-    reconfigure_ = std::make_unique<FollowerReconfigure>(private_nh, name, parameters,
-                                                         cycle_.get(), outputs_.get());
+    reconfigure_ = std::make_unique<FollowerReconfigure>(private_nh, name, parameters, cycle_.get(),
+                                                         outputs_.get());
     if (options.control_loop == ControlLoop::kThread) {
       outputs_->startThread([this] { reconfigure_->collectRetired(); });
     }
-    loop_ = std::make_unique<FollowerLoop>(nh, name, options, parameters.control_rate,
-                                           cycle_.get(), outputs_.get());
+    loop_ = std::make_unique<FollowerLoop>(nh, name, options, parameters.control_rate, cycle_.get(),
+                                           outputs_.get());
   } catch (...) {
     stop();  // the parts already running, in the order the destructor stops them
     throw;

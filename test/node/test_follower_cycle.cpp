@@ -11,12 +11,13 @@
 
 #include <gtest/gtest.h>
 
-#include "AllocationCounter.hpp"
-#include "TestScenarios.hpp"
 #include "projection_collision_avoidance/ControllerDesign.hpp"
 #include "projection_collision_avoidance/node/FollowerCycle.hpp"
 #include "projection_collision_avoidance/rt/Handoff.hpp"
 #include "projection_collision_avoidance/rt/LatestValue.hpp"
+
+#include "AllocationCounter.hpp"
+#include "TestScenarios.hpp"
 
 namespace projection_collision_avoidance {
 namespace {
@@ -65,7 +66,8 @@ TEST(FollowerCycle, TheControlThreadAllocatesAndFreesNothing) {
       const std::int64_t now = clock.load();
       const bool outage = now > kStart + 4000 * kMs && now < kStart + 5000 * kMs;
       if (now != last && !outage) {
-        cycle->measurement().write(measurementAt(now, ++sequence, 5.0 + 0.5 * std::sin(1e-9 * now)));
+        cycle->measurement().write(
+            measurementAt(now, ++sequence, 5.0 + 0.5 * std::sin(1e-9 * now)));
         LeaderSample leader;
         leader.stamp_ns = leader.receipt_ns = now;
         leader.acceleration.setConstant(1, -0.5);

@@ -34,40 +34,40 @@ struct LeaderSample {
 
 /// What the follower's control cycle needs besides the controller's design.
 struct FollowerCycleSettings {
-  double measurement_timeout = 0.5;   ///< s: an older measurement is stale
-  double leader_timeout = 0.5;        ///< s: an older leader broadcast is stale
-  bool use_leader_input = false;      ///< give the controller a fresh leader acceleration
-  bool measurement_trigger = false;   ///< steps answer measurements; ticks only brake
+  double measurement_timeout = 0.5;  ///< s: an older measurement is stale
+  double leader_timeout = 0.5;       ///< s: an older leader broadcast is stale
+  bool use_leader_input = false;     ///< give the controller a fresh leader acceleration
+  bool measurement_trigger = false;  ///< steps answer measurements; ticks only brake
 };
 
 /// What a tick or step gives the outputs: the step's results when one ran, and the counters.
 /// Fixed size: filling it allocates nothing.
 struct FollowerCycleOutput {
-  bool stepped = false;           ///< a control step ran (else: waiting, stalled, or a tick of the
-                                  ///< measurement trigger while the measurement is fresh)
-  std::int64_t now_ns = 0;        ///< ROS time of the tick or measurement that gave this output
-  std::int64_t stamp_ns = 0;      ///< the step's stamp: tick time, or the measurement's stamp
-  std::uint64_t steps = 0;        ///< control steps run since start, this one included
+  bool stepped = false;       ///< a control step ran (else: waiting, stalled, or a tick of the
+                              ///< measurement trigger while the measurement is fresh)
+  std::int64_t now_ns = 0;    ///< ROS time of the tick or measurement that gave this output
+  std::int64_t stamp_ns = 0;  ///< the step's stamp: tick time, or the measurement's stamp
+  std::uint64_t steps = 0;    ///< control steps run since start, this one included
   FollowerMode mode = FollowerMode::kWaiting;
   bool leader_fresh = false;
-  double measurement_age = 0.0;   ///< s at the stamp; +inf when none on this timeline
-  double leader_age = 0.0;        ///< s at the stamp; +inf when none on this timeline
+  double measurement_age = 0.0;       ///< s at the stamp; +inf when none on this timeline
+  double leader_age = 0.0;            ///< s at the stamp; +inf when none on this timeline
   GenericDimensions::StateVector xi;  ///< x_target - x_i - d of the measurement used (m, m/s)
   double distance = 0.0;              ///< ||p_target - p_i|| of that measurement (m)
   RuntimeFollowerStatus status;       ///< the controller's step
   // The design in force (filled with or without a step).
-  double xi_max = 0.0;                ///< (1 - alpha) ||d|| in force (m)
-  double xi_soft = 0.0;               ///< xi_max / sqrt(1 + epsilon) in force (m)
-  double perimeter = 0.0;             ///< alpha ||d|| in force (m)
-  double acceleration_limit = 0.0;    ///< in force (m/s^2)
-  double jerk_limit = 0.0;            ///< in force (m/s^3)
-  bool tracker_enabled = false;       ///< in force
+  double xi_max = 0.0;              ///< (1 - alpha) ||d|| in force (m)
+  double xi_soft = 0.0;             ///< xi_max / sqrt(1 + epsilon) in force (m)
+  double perimeter = 0.0;           ///< alpha ||d|| in force (m)
+  double acceleration_limit = 0.0;  ///< in force (m/s^2)
+  double jerk_limit = 0.0;          ///< in force (m/s^3)
+  bool tracker_enabled = false;     ///< in force
   std::uint32_t missed_periods = 0;
   std::uint32_t late_periods = 0;
-  double tick_delay = 0.0;            ///< s, of the latest step
-  std::uint32_t time_jumps = 0;       ///< jumps back of ROS time since start
-  double time_jump = 0.0;             ///< s (negative): the jump seen at this tick, else 0
-  double stall = 0.0;                 ///< s: a tick this late began a wait for input, else 0
+  double tick_delay = 0.0;       ///< s, of the latest step
+  std::uint32_t time_jumps = 0;  ///< jumps back of ROS time since start
+  double time_jump = 0.0;        ///< s (negative): the jump seen at this tick, else 0
+  double stall = 0.0;            ///< s: a tick this late began a wait for input, else 0
 };
 
 /// The follower's control cycle without ROS: it reads the latest accepted inputs from lock-free
@@ -146,7 +146,7 @@ class FollowerCycle {
   std::int64_t latest_time_ns_ = 0;  ///< latest ROS time seen (jumps back)
   std::uint32_t time_jumps_ = 0;
   double time_jump_ = 0.0;
-  bool resuming_ = false;            ///< waiting for input after a stall
+  bool resuming_ = false;  ///< waiting for input after a stall
   std::int64_t resumed_at_ns_ = 0;
   std::uint64_t sequence_at_stall_ = 0;
   double stall_ = 0.0;

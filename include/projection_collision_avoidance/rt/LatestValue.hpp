@@ -44,9 +44,9 @@ class LatestValue {
   static constexpr std::uint8_t kFresh = 0x4;
 
   T buffers_[3] = {};
-  std::uint8_t back_ = 0;                   ///< the writer's buffer
-  std::atomic<std::uint8_t> middle_{1};     ///< index of the middle buffer, | kFresh when new
-  std::uint8_t front_ = 2;                  ///< the reader's buffer
+  std::uint8_t back_ = 0;                ///< the writer's buffer
+  std::atomic<std::uint8_t> middle_{1};  ///< index of the middle buffer, | kFresh when new
+  std::uint8_t front_ = 2;               ///< the reader's buffer
 };
 
 }  // namespace projection_collision_avoidance

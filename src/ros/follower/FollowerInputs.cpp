@@ -17,9 +17,9 @@ FollowerInputs::FollowerInputs(std::string node_name, const FollowerNodeOptions&
       cycle_(cycle),
       on_step_(std::move(on_step)),
       // A message older than its timeout on arrival could only be stale: refused as such.
-      measurement_guard_("relative_measurement", {options.measurement_frame,
-                                                  options.max_future_stamp,
-                                                  options.measurement_timeout}),
+      measurement_guard_(
+          "relative_measurement",
+          {options.measurement_frame, options.max_future_stamp, options.measurement_timeout}),
       leader_guard_("leader_broadcast", {options.leader_broadcast_frame, options.max_future_stamp,
                                          options.leader_timeout}) {
   measurement_.relative_state.setZero(2 * axes_);
@@ -30,7 +30,8 @@ FollowerInputs::FollowerInputs(std::string node_name, const FollowerNodeOptions&
 void FollowerInputs::start(ros::NodeHandle nh) {
   measurement_subscriber_ = nh.subscribe("relative_measurement", 10, &FollowerInputs::onMeasurement,
                                          this, ros::TransportHints().tcpNoDelay());
-  leader_subscriber_ = nh.subscribe("leader_broadcast", 10, &FollowerInputs::onLeaderBroadcast, this);
+  leader_subscriber_ =
+      nh.subscribe("leader_broadcast", 10, &FollowerInputs::onLeaderBroadcast, this);
 }
 
 void FollowerInputs::Heard::note(std::int64_t stamp_ns, std::int64_t now_ns) {
@@ -70,7 +71,8 @@ bool FollowerInputs::admitHeader(InputGuard& guard, ClockWatch& clock, Heard& he
 void FollowerInputs::onMeasurement(const RelativeMeasurement::ConstPtr& msg) {
   admitGuarded(measurement_guard_, name_, [&] {
     const ros::Time now = ros::Time::now();
-    if (!admitHeader(measurement_guard_, measurement_clock_, measurement_heard_, msg->header, now)) {
+    if (!admitHeader(measurement_guard_, measurement_clock_, measurement_heard_, msg->header,
+                     now)) {
       return;
     }
     std::string why;

@@ -8,13 +8,14 @@
 
 #include <ros/ros.h>
 
-#include "follower/FollowerOptions.hpp"
 #include "projection_collision_avoidance/ControllerDesign.hpp"
 #include "projection_collision_avoidance/LeaderBroadcast.h"
 #include "projection_collision_avoidance/RelativeMeasurement.h"
 #include "projection_collision_avoidance/node/FollowerCycle.hpp"
 #include "projection_collision_avoidance/ros/InputAdmission.hpp"
 #include "projection_collision_avoidance/ros/InputGuard.hpp"
+
+#include "follower/FollowerOptions.hpp"
 
 namespace projection_collision_avoidance {
 
@@ -25,8 +26,9 @@ struct FollowerInputStats {
   std::uint64_t rejected_leader_broadcasts = 0;
   std::string measurement_rejection;  ///< the latest, "" once one was accepted after it
   std::string leader_rejection;
-  double measurement_age = -1.0;  ///< s, of the last accepted measurement; -1: none on this timeline
-  double leader_age = -1.0;       ///< s, of the last accepted leader broadcast; -1: none
+  double measurement_age =
+      -1.0;                  ///< s, of the last accepted measurement; -1: none on this timeline
+  double leader_age = -1.0;  ///< s, of the last accepted leader broadcast; -1: none
 };
 
 /// The follower's inputs: subscribes `relative_measurement` and `leader_broadcast`, judges each

@@ -7,11 +7,12 @@
 #include <ros/callback_queue.h>
 #include <ros/ros.h>
 
-#include "follower/FollowerOptions.hpp"
-#include "follower/FollowerOutputs.hpp"
 #include "projection_collision_avoidance/node/FollowerCycle.hpp"
 #include "projection_collision_avoidance/ros/InputAdmission.hpp"
 #include "projection_collision_avoidance/ros/RealtimeLoop.hpp"
+
+#include "follower/FollowerOptions.hpp"
+#include "follower/FollowerOutputs.hpp"
 
 namespace projection_collision_avoidance {
 
@@ -50,7 +51,7 @@ class FollowerLoop {
   double period_;
   FollowerCycleOutput timer_output_;   ///< the timer thread's
   FollowerCycleOutput thread_output_;  ///< the control thread's
-  ClockWatch clock_;  ///< jumps back of ROS time at the timer's ticks
+  ClockWatch clock_;                   ///< jumps back of ROS time at the timer's ticks
   ros::Time last_expected_;
   bool have_last_expected_ = false;
   ros::CallbackQueue queue_;

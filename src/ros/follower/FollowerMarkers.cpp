@@ -3,9 +3,10 @@
 
 #include <visualization_msgs/MarkerArray.h>
 
-#include "follower/FollowerOutputs.hpp"
 #include "projection_collision_avoidance/ros/InputAdmission.hpp"
 #include "projection_collision_avoidance/ros/MessageConversions.hpp"
+
+#include "follower/FollowerOutputs.hpp"
 
 namespace projection_collision_avoidance {
 
@@ -48,8 +49,8 @@ void FollowerOutputs::publishMarkers(const FollowerCycleOutput& out) {
       toMarker(frame, now, "bound", member_.index, Marker::TEXT_VIEW_FACING,
                Eigen::Vector3d(0.0, 0.0, 1.2), 0.35, {1.0F, shade, shade, 1.0F});
   std::ostringstream label;
-  label << std::fixed << std::setprecision(2) << "|xi| " << xi.norm() << " / xi_max "
-        << out.xi_max << " m";
+  label << std::fixed << std::setprecision(2) << "|xi| " << xi.norm() << " / xi_max " << out.xi_max
+        << " m";
   if (fallback) {
     label << "\nMEASUREMENT LOST: braking";
   } else if (out.mode == FollowerMode::kLeaderLost) {

@@ -50,7 +50,7 @@ FormationMember memberOf(NodeOptionReader& reader, const Scenario& scenario) {
 }
 
 FollowerNodeOptions readFollowerOptions(NodeOptionReader& reader, const ControllerParameters& p,
-                                const FormationMember& member, bool sim_time) {
+                                        const FormationMember& member, bool sim_time) {
   FollowerNodeOptions options;
   options.formation_index = member.index;
   const double period = 1.0 / p.control_rate;

@@ -8,11 +8,12 @@
 #include <geometry_msgs/AccelStamped.h>
 #include <visualization_msgs/MarkerArray.h>
 
-#include "follower/StatusMessage.hpp"
 #include "projection_collision_avoidance/FollowerStatus.h"
 #include "projection_collision_avoidance/LeaderBroadcast.h"
 #include "projection_collision_avoidance/ros/InputAdmission.hpp"
 #include "projection_collision_avoidance/ros/MessageConversions.hpp"
+
+#include "follower/StatusMessage.hpp"
 
 namespace projection_collision_avoidance {
 

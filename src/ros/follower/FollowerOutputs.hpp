@@ -3,19 +3,20 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
-#include <mutex>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <thread>
 
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <ros/ros.h>
 
-#include "follower/FollowerInputs.hpp"
-#include "follower/FollowerOptions.hpp"
 #include "projection_collision_avoidance/Formation.hpp"
 #include "projection_collision_avoidance/node/FollowerCycle.hpp"
 #include "projection_collision_avoidance/rt/Handoff.hpp"
+
+#include "follower/FollowerInputs.hpp"
+#include "follower/FollowerOptions.hpp"
 
 namespace projection_collision_avoidance {
 
@@ -72,7 +73,7 @@ class FollowerOutputs {
   const FollowerInputs* inputs_;
   std::uint64_t steps_per_marker_ = 0;
 
-  std::mutex publish_mutex_;     ///< publish(): the timer's or outputs' thread vs a measurement's
+  std::mutex publish_mutex_;    ///< publish(): the timer's or outputs' thread vs a measurement's
   FollowerCycleOutput latest_;  ///< the latest step, with the counters of the latest output
   /// Keeps the latest step's results in latest_ and takes the counters and design of @p out.
   void remember(const FollowerCycleOutput& out);

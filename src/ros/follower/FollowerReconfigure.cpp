@@ -50,7 +50,8 @@ void FollowerReconfigure::onReconfigure(FollowerConfig& config, uint32_t /*level
   candidate.epsilon = config.epsilon;
   try {
     for (const auto& [name, value] :
-         {std::pair<const char*, double>{"alpha", config.alpha}, {"epsilon", config.epsilon},
+         {std::pair<const char*, double>{"alpha", config.alpha},
+          {"epsilon", config.epsilon},
           {"tracker_natural_frequency", config.tracker_natural_frequency},
           {"tracker_damping", config.tracker_damping}}) {
       if (!std::isfinite(value)) {
@@ -79,8 +80,9 @@ void FollowerReconfigure::onReconfigure(FollowerConfig& config, uint32_t /*level
     cycle_->offer(std::move(controller)).reset();  // an offer not yet adopted is superseded
     parameters_ = candidate;
     outputs_->describeTrackerGain(parameters_.tracker_gain);
-    ROS_INFO_STREAM(name_ << ": reconfigured: tracker " << (candidate.tracker_enabled ? "on" : "off")
-                          << ", alpha " << candidate.alpha << ", epsilon " << candidate.epsilon
+    ROS_INFO_STREAM(name_ << ": reconfigured: tracker "
+                          << (candidate.tracker_enabled ? "on" : "off") << ", alpha "
+                          << candidate.alpha << ", epsilon " << candidate.epsilon
                           << ", tracker gain "
                           << (config.tracker_natural_frequency > 0.0 ? "from the frequency"
                                                                      : "of the scenario file")

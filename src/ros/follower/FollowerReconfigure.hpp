@@ -8,10 +8,11 @@
 #include <dynamic_reconfigure/server.h>
 #include <ros/ros.h>
 
-#include "follower/FollowerOutputs.hpp"
 #include "projection_collision_avoidance/ControllerParameters.hpp"
 #include "projection_collision_avoidance/FollowerConfig.h"
 #include "projection_collision_avoidance/node/FollowerCycle.hpp"
+
+#include "follower/FollowerOutputs.hpp"
 
 namespace projection_collision_avoidance {
 

@@ -2,10 +2,11 @@
 
 #include <string>
 
-#include "follower/FollowerInputs.hpp"
 #include "projection_collision_avoidance/FollowerStatus.h"
 #include "projection_collision_avoidance/Formation.hpp"
 #include "projection_collision_avoidance/node/FollowerCycle.hpp"
+
+#include "follower/FollowerInputs.hpp"
 
 namespace projection_collision_avoidance {
 

@@ -121,8 +121,8 @@ void PlantClock::rosTick() {
     // Under use_sim_time scenario time is ROS time; otherwise it starts at the first tick.
     started_ = true;
     origin_ = ros::Time::isSimTime() ? ros::Time(0) : now;
-    next_tick_ = static_cast<long>(
-        std::ceil(secondsBetween(now, origin_) * options_.rate - kTickTolerance));
+    next_tick_ =
+        static_cast<long>(std::ceil(secondsBetween(now, origin_) * options_.rate - kTickTolerance));
     if (last_tick_ >= 0 && next_tick_ > last_tick_) {
       std::ostringstream why;
       why << "ROS time " << now.toSec() << " s is already past ~duration = " << options_.duration
@@ -131,8 +131,8 @@ void PlantClock::rosTick() {
       return;
     }
   }
-  const long due = static_cast<long>(
-      std::floor(secondsBetween(now, origin_) * options_.rate + kTickTolerance));
+  const long due =
+      static_cast<long>(std::floor(secondsBetween(now, origin_) * options_.rate + kTickTolerance));
   if (due < next_tick_ - 1) {
     return;  // ROS time went back: wait for it to reach the next tick again
   }

@@ -6,8 +6,9 @@
 
 #include <ros/ros.h>
 
-#include "plant/PlantOptions.hpp"
 #include "projection_collision_avoidance/ros/InputAdmission.hpp"
+
+#include "plant/PlantOptions.hpp"
 
 namespace projection_collision_avoidance {
 

@@ -15,10 +15,10 @@ struct PlantNodeOptions {
   std::string leader_frame = "leader";      ///< the leader's tf frame
   std::string follower_frame = "follower";  ///< the follower's tf frame
   MeasurementFaults faults;                 ///< ~measurement_*, ~noise_seed
-  double command_timeout = 0.5;   ///< s; an older command (by its stamp) counts as zero
-  bool publish_clock = false;     ///< drive the ticks on wall time and publish /clock
-  double real_time_factor = 1.0;  ///< simulated s per wall s with publish_clock
-  double duration = 0.0;          ///< s of simulated time, then shut down; 0 = forever
+  double command_timeout = 0.5;             ///< s; an older command (by its stamp) counts as zero
+  bool publish_clock = false;               ///< drive the ticks on wall time and publish /clock
+  double real_time_factor = 1.0;            ///< simulated s per wall s with publish_clock
+  double duration = 0.0;                    ///< s of simulated time, then shut down; 0 = forever
 };
 
 /// The plant node's options from its private namespace, each validated (the message names the

@@ -38,8 +38,8 @@ visualization_msgs::Marker labelMarker(const std::string& frame, const ros::Time
 }  // namespace
 
 PlantWorld::Agent::Agent(const std::string& agent_name, const std::string& tf_frame,
-                        const AgentModel& model, double step, const Eigen::VectorXd& initial_state,
-                        const SignalProfile& disturbance, double command_timeout)
+                         const AgentModel& model, double step, const Eigen::VectorXd& initial_state,
+                         const SignalProfile& disturbance, double command_timeout)
     : name(agent_name),
       frame(tf_frame),
       integrator(model, step, initial_state, disturbance),

@@ -17,6 +17,7 @@
 #include "projection_collision_avoidance/ros/InputGuard.hpp"
 #include "projection_collision_avoidance/ros/RosParameters.hpp"
 #include "projection_collision_avoidance/sim/MeasurementChannel.hpp"
+
 #include "plant/PlantClock.hpp"
 #include "plant/PlantOptions.hpp"
 
@@ -41,10 +42,10 @@ namespace projection_collision_avoidance {
 /// the command it held over that step as `leader/applied_command` and
 /// `<follower>/applied_command`.
 ///
-/// Time: PlantClock. With publish_clock the plant owns simulated time (stamps t_k from 0), ticking on a wall
-/// timer at rate * real_time_factor (catching up ticks that a late callback missed). Otherwise it
-/// ticks on ROS time, catching up every tick that is due; scenario time is ROS time under
-/// use_sim_time and the time since the first tick otherwise.
+/// Time: PlantClock. With publish_clock the plant owns simulated time (stamps t_k from 0), ticking
+/// on a wall timer at rate * real_time_factor (catching up ticks that a late callback missed).
+/// Otherwise it ticks on ROS time, catching up every tick that is due; scenario time is ROS time
+/// under use_sim_time and the time since the first tick otherwise.
 class PlantWorld {
  public:
   /// @throws ParameterError naming the parameter when the scenario or an option is invalid
