@@ -113,7 +113,11 @@ void FollowerOutputs::run(const std::function<void()>& idle) {
   std::uint32_t seen = handoff_.count();
   while (true) {
     while (handoff_.pop(&out)) {
-      publish(out);
+      try {
+        publish(out);
+      } catch (const std::exception& error) {  // as a tick of the timer loop would report it
+        ROS_ERROR_STREAM_THROTTLE(5.0, name_ << ": control tick failed: " << error.what());
+      }
     }
     if (idle) {
       idle();
