@@ -56,10 +56,13 @@ using FormationObserver = std::function<void(int member, const SimulationSample&
 /// Runs the closed loop of a scenario's formation without ROS: at each tick t_k = k /
 /// control_rate, for k = 0 .. round(duration * control_rate), every follower i in index order
 /// steps on y_i = C (x_target - x_i - d_i); then every agent is integrated exactly to t_{k+1},
-/// inputs held, the leader's step split at disturbance pulse edges. With leader information
-/// (controller.leader_information) a follower of the leader is given a_1 = u_1(t_k) (+ pinv(B)
-/// u_d(t_k) when the disturbance is shared), and a follower of follower j the command follower j
-/// computed at the same tick. Throws ParameterError for an invalid scenario.
+/// inputs held, the leader's step split at disturbance pulse edges. Each follower is given its own
+/// state x_i for the time headway (S1). With leader information (controller.leader_information)
+/// a follower of the leader is given a_1 = u_1(t_k) (+ pinv(B) u_d(t_k) when the disturbance is
+/// shared), and a follower of follower j the command follower j computed at the same tick; with
+/// a link section, these values as the link delivers them instead ((L1)-(L3): delayed by D
+/// periods, lost with probability dropout, the last one held). Throws ParameterError for an
+/// invalid scenario.
 FormationSummary simulateFormation(const Scenario& scenario,
                                    const FormationObserver& observer = {});
 
