@@ -24,6 +24,7 @@ import re
 import sys
 
 import numpy as np
+import yaml
 
 import matplotlib
 
@@ -34,8 +35,18 @@ MILLIMETRE = 1e-3
 SHOWN = (1, 2, 3, 5, 10, 12, 15, 17, 20, 25, 30, 50, 75, 100)
 
 
-def parse(path):
-    """{"followers": [{index, max_xi, xi_max, min_separation, perimeter}], "pair", "figures"}."""
+def alpha_of(row):
+    """controller.alpha of the run: the scenario's, or its --set override."""
+    m = re.search(r"--set controller\.alpha=(\S+)", row["arguments"])
+    if m:
+        return float(m.group(1))
+    with open(row["scenario"], encoding="utf-8") as fh:
+        return float(yaml.safe_load(fh)["controller"]["alpha"])
+
+
+def parse(path, alpha):
+    """{"followers": [{index, max_xi, xi_max, min_separation, perimeter}], "pair", "figures"},
+    with the perimeter alpha ||d_i|| = xi_max,i alpha / (1 - alpha)."""
     followers, pair, figures = [], None, None
     with open(path, encoding="utf-8") as fh:
         for line in fh:
@@ -45,6 +56,7 @@ def parse(path):
             if m:
                 entry = {k: float(v) for k, v in values.items() if k != "target"}
                 entry["index"] = int(m.group(1))
+                entry["perimeter"] = entry["xi_max"] * alpha / (1.0 - alpha)
                 followers.append(entry)
             elif words and words[0] == "formation":
                 pair = float(values["min_pair_separation"])
@@ -80,6 +92,8 @@ def verdict(run, n):
     if bad:
         return f"**unsafe from N = {min(bad)}**"
     ratio = fig["peak_ratio_max"]
+    if run["topology"] == "star":
+        return f"safe to N = {n} (a star passes nothing on)"
     if math.isnan(ratio):
         return f"safe to N = {n}, peaks ≈ 0 behind follower 1"
     if ratio <= 1.0:
@@ -100,6 +114,13 @@ def number(x):
     return f"{x:.1e}" if abs(x) < 1e-3 and x != 0 else f"{x:.4g}"
 
 
+def ratio(x):
+    """A peak ratio: 4 digits, or 9 where it lies within 1e-3 of 1."""
+    if math.isnan(x):
+        return "n/a"
+    return f"{x:.9g}" if abs(x - 1.0) < 1e-3 else f"{x:.4g}"
+
+
 def summary_table(rows, runs, n):
     lines = ["| # | configuration | peak ‖ξ_1‖ | peak ‖ξ_N‖ | growth per follower, i ≥ 2 "
              "| max peak_{i+1}/peak_i | first out of ξ_max | first inside perimeter "
@@ -109,7 +130,7 @@ def summary_table(rows, runs, n):
         fs, fig = run["followers"], run["figures"]
         lines.append(
             f"| {k} | {label(row)} | {number(fs[0]['max_xi'])} | {number(fs[-1]['max_xi'])} | "
-            f"{number(fig['peak_growth'])} | {number(fig['peak_ratio_max'])} | "
+            f"{number(fig['peak_growth'])} | {ratio(fig['peak_ratio_max'])} | "
             f"{first(int(fig['first_outside_bound']))} | "
             f"{first(int(fig['first_inside_perimeter']))} | "
             f"{first(first_within(run, MILLIMETRE))} | {number(run['pair'])} | "
@@ -134,33 +155,40 @@ def follower_table(rows, runs, picks, key, bound, what):
 
 
 def plot(rows, runs, path):
+    """Left: the paper's laws and the headway alone (log scale); right: the chosen
+    configuration's chains (linear scale)."""
     fig, axes = plt.subplots(2, 2, figsize=(15, 11))
-    groups = (("paper", "the paper's laws"), ("chosen", "the string-stable configuration"))
-    for col, (group, title) in enumerate(groups):
-        picks = [k for k, r in enumerate(rows) if r["group"] == group or
-                 (group == "chosen" and r["group"].startswith("headway"))]
-        for k in picks:
+    right = [k for k, r in enumerate(rows)
+             if r["group"].startswith("chosen") and r["topology"] == "chain"]
+    left = [k for k in range(len(rows)) if k not in right and rows[k]["topology"] == "chain"]
+    titles = ("chains, the paper's laws and the headway alone", "chains, the string-stable configuration")
+    for col, (picks, title) in enumerate(zip((left, right), titles)):
+        colors = plt.cm.tab20(np.linspace(0.0, 1.0, max(len(picks), 2)))
+        for n, k in enumerate(picks):
             fs = runs[k]["followers"]
             i = np.array([f["index"] for f in fs])
-            style = dict(lw=1.4, ls="-" if rows[k]["topology"] == "chain" else "--")
+            style = dict(lw=1.4, color=colors[n],
+                         ls="--" if rows[k]["topology"] == "star" else ("-" if n % 2 == 0 else "-."))
             axes[0, col].plot(i, [f["max_xi"] for f in fs], label=f"#{k + 1} {label(rows[k])}",
                               **style)
             axes[1, col].plot(i, [max(f["min_separation"], 1e-7) for f in fs], **style)
-        xi_max = runs[picks[0]]["followers"][0]["xi_max"]
-        perimeter = runs[picks[0]]["followers"][0]["perimeter"]
-        axes[0, col].axhline(xi_max, color="black", ls=":", lw=1.5, label=f"ξ_max = {xi_max:g} m "
-                             "(chain; star: i ξ_max)")
-        axes[1, col].axhline(perimeter, color="black", ls=":", lw=1.5)
+        first = runs[picks[0]]["followers"][0]
+        axes[0, col].axhline(first["xi_max"], color="black", ls=":", lw=1.5,
+                             label=f"ξ_max = {first['xi_max']:g} m (chain; star: i ξ_max)")
+        axes[1, col].axhline(first["perimeter"], color="black", ls=":", lw=1.5,
+                             label=f"perimeter {first['perimeter']:g} m (chain; star: i times)")
         axes[0, col].set_title(f"peak ‖ξ_i‖, {title}")
         axes[1, col].set_title(f"min separation to the target, {title}")
-        axes[0, col].legend(fontsize=6.5, loc="upper left")
+        axes[0, col].legend(fontsize=6.5, loc="upper left" if col == 0 else "lower left")
+        axes[1, col].legend(fontsize=7, loc="lower right")
         for row in range(2):
             axes[row, col].set_xlabel("follower i")
             axes[row, col].grid(True, which="both", alpha=0.3)
-        if group == "paper":
-            axes[0, col].set_yscale("log")
-            axes[1, col].set_yscale("log")
-            axes[0, col].set_ylim(0.1, 1e3)
+    for row in range(2):
+        axes[row, 0].set_yscale("log")
+    axes[0, 0].set_ylim(1e-2, 1e16)
+    axes[0, 1].set_ylim(0.0, 1.3 * runs[right[0]]["followers"][0]["xi_max"])
+    axes[1, 1].set_ylim(0.0, 5.5)
     axes[0, 0].set_ylabel("m")
     axes[1, 0].set_ylabel("m (below 1e-7 drawn at 1e-7)")
     fig.tight_layout()
@@ -179,10 +207,12 @@ def main(argv=None):
     try:
         with open(args.manifest, encoding="utf-8") as fh:
             rows = list(csv.DictReader(fh, delimiter="\t"))
-        runs = [parse(r["file"]) for r in rows]
+        runs = [parse(r["file"], alpha_of(r)) for r in rows]
+        for row, run in zip(rows, runs):
+            run["topology"] = row["topology"]
         with open(args.gamma, encoding="utf-8") as fh:
             gamma = fh.read().rstrip("\n").split("\n")
-    except (OSError, ValueError, KeyError) as exc:
+    except (OSError, ValueError, KeyError, TypeError, yaml.YAMLError) as exc:
         print(f"plot_string_stability: error: {exc}", file=sys.stderr)
         return 1
     n = args.followers
@@ -194,8 +224,13 @@ def main(argv=None):
             for f in run["followers"]:
                 out.writerow([k, label(row), f["index"], repr(f["max_xi"]), repr(f["xi_max"]),
                               repr(f["min_separation"]), repr(f["perimeter"])])
-    paper = [k for k, r in enumerate(rows) if r["group"] == "paper"]
-    chosen = [k for k, r in enumerate(rows) if r["group"] != "paper"]
+    # Per follower: the runs whose tables say something (not the same-tick zeros, not the
+    # repeats at another delay); every run is in the CSV.
+    paper = [k for k, r in enumerate(rows) if r["group"].startswith("paper")
+             and r["sharing"] != "same tick" and not (r["topology"] == "star" and r["sharing"] == "link")]
+    chosen = [k for k, r in enumerate(rows) if not r["group"].startswith("paper") and (
+        r["sharing"] != "link" or r["tracker"] == "false" or r["topology"] == "star"
+        or (r["dropout"] != "0" and r["delay"] in ("0.1", "0.2")))]
     text = ["# String stability", "",
             f"Generated by `bash scripts/string_stability.sh` ({len(rows)} cf_sim runs of "
             f"N = {n} followers in {args.wall} s, then the analysis): the paper's push on the "

@@ -27,14 +27,19 @@ mkdir -p "$out"
 paper=config/scenarios/paper_run2.yaml
 platoon=config/scenarios/platoon_run2.yaml
 info=controller.leader_information
-shared="--set $info.command=true --set $info.disturbance=true"
+# cf_sim arguments are kept ';'-separated, so that a value may hold spaces.
+set_() { printf -- '--set;%s;' "$@"; }
+shared=$(set_ "$info.command=true" "$info.disturbance=true")
 # A link of LATENCY seconds (or 1 period with "T") losing DROPOUT of the messages, seed 1.
 link() {
   local periods=0 latency=$1
   if [[ $1 == T ]]; then periods=1 latency=0; fi
-  echo "--set $info.link.delay_periods=$periods --set $info.link.latency=$latency" \
-    "--set $info.link.dropout=$2 --set $info.link.seed=1"
+  set_ "$info.link.delay_periods=$periods" "$info.link.latency=$latency" \
+    "$info.link.dropout=$2" "$info.link.seed=1"
 }
+# After the push the leader brakes back to rest (1 m/s^2 for 6 s): the steady reverse speed, and
+# with it the headway's steady offset h |v|, is gone, and the peaks measure the transient alone.
+stop=$(set_ "leader.input={pulses: [{start: 23.0, end: 29.0, vector: [1.0]}]}")
 # group|rate|topology|tracker|sharing|delay|dropout|scenario|cf_sim arguments
 runs=()
 for rate in 100 1000; do
@@ -47,15 +52,16 @@ for tracker in false true; do
   runs+=("paper|100|star|$tracker|none|-|-|$paper|")
 done
 for delay in T 0.02 0.1; do
-  runs+=("paper|100|chain|true|link|$delay|0|$paper|$shared $(link "$delay" 0)")
+  runs+=("paper|100|chain|true|link|$delay|0|$paper|$shared$(link "$delay" 0)")
 done
 for tracker in false true; do
-  runs+=("paper|100|chain|$tracker|link|0.1|0.2|$paper|$shared $(link 0.1 0.2)")
+  runs+=("paper|100|chain|$tracker|link|0.1|0.2|$paper|$shared$(link 0.1 0.2)")
 done
-runs+=("paper|1000|chain|true|link|0.1|0.2|$paper|$shared $(link 0.1 0.2)")
-runs+=("paper|100|star|true|link|0.1|0.2|$paper|$shared $(link 0.1 0.2)")
+runs+=("paper|1000|chain|true|link|0.1|0.2|$paper|$shared$(link 0.1 0.2)")
+runs+=("paper|100|star|true|link|0.1|0.2|$paper|$shared$(link 0.1 0.2)")
+runs+=("paper, leader stops|100|chain|true|none|-|-|$paper|$stop")
 for rate in 100 1000; do
-  runs+=("chosen|$rate|chain|true|same tick|0|0|$platoon|--set $info.link=null")
+  runs+=("chosen|$rate|chain|true|same tick|0|0|$platoon|$(set_ "$info.link=null")")
   for delay in T 0.02 0.1; do
     for dropout in 0 0.2; do
       runs+=("chosen|$rate|chain|true|link|$delay|$dropout|$platoon|$(link "$delay" "$dropout")")
@@ -64,10 +70,15 @@ for rate in 100 1000; do
   runs+=("chosen|$rate|chain|true|link|0.2|0.2|$platoon|$(link 0.2 0.2)")
 done
 runs+=("chosen|100|chain|false|link|0.1|0.2|$platoon|$(link 0.1 0.2)")
-runs+=("chosen|100|star|true|link|0.1|0.2|$platoon|--set formation.topology=star $(link 0.1 0.2)")
-# The headway alone, nothing shared (ACC): 0.3 s is not enough, 1 s is.
+runs+=("chosen|100|star|true|link|0.1|0.2|$platoon|$(link 0.1 0.2)")
+for rate in 100 1000; do
+  for delay in 0.1 0.2; do
+    runs+=("chosen, leader stops|$rate|chain|true|link|$delay|0.2|$platoon|$stop$(link "$delay" 0.2)")
+  done
+done
+# The headway alone, nothing shared (ACC): 0.3 s is not enough, 1 s is too much for a reversal.
 for headway in 0.3 1.0; do
-  headway_only="--set $info=null --set controller.spacing.time_headway=$headway"
+  headway_only=$(set_ "$info=null" "controller.spacing.time_headway=$headway")
   runs+=("headway $headway s alone|100|chain|true|none|-|-|$platoon|$headway_only")
 done
 
@@ -81,13 +92,17 @@ cd "$root"
 for i in "${!runs[@]}"; do
   IFS='|' read -r group rate topology tracker sharing delay dropout scenario arguments \
     <<<"${runs[$i]}"
-  common="--set controller.control_rate=$rate --set formation.followers=$followers"
-  common+=" --set formation.topology=$topology --set formation.shape=line"
-  common+=" --set controller.tracker.enabled=$tracker"
-  # shellcheck disable=SC2086
-  "$CF_SIM" "$scenario" $common $arguments >"$work/$i.txt"
+  common=$(set_ "controller.control_rate=$rate" "formation.followers=$followers" \
+    "formation.topology=$topology" "formation.shape=line" "controller.tracker.enabled=$tracker")
+  IFS=';' read -ra argv <<<"$common$arguments"
+  "$CF_SIM" "$scenario" "${argv[@]}" >"$work/$i.txt"
+  # The arguments as a shell would take them, for the report.
+  quoted=""
+  for word in "${argv[@]}"; do
+    if [[ $word =~ ^[A-Za-z0-9_.=/:+-]*$ ]]; then quoted+="$word "; else quoted+="'$word' "; fi
+  done
   printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$group" "$rate" "$topology" "$tracker" \
-    "$sharing" "$delay" "$dropout" "$scenario" "$common $arguments" "$work/$i.txt" >>"$manifest"
+    "$sharing" "$delay" "$dropout" "$scenario" "$quoted" "$work/$i.txt" >>"$manifest"
 done
 wall=$(/usr/bin/python3 -c "import sys; print(f'{float(sys.argv[2]) - float(sys.argv[1]):.1f}')" \
   "$start" "$(date +%s.%N)")
