@@ -179,7 +179,8 @@ def plot(rows, runs, path):
                              label=f"perimeter {first['perimeter']:g} m (chain; star: i times)")
         axes[0, col].set_title(f"peak ‖ξ_i‖, {title}")
         axes[1, col].set_title(f"min separation to the target, {title}")
-        axes[0, col].legend(fontsize=6.5, loc="upper left" if col == 0 else "lower left")
+        axes[0, col].legend(fontsize=6.5 if col == 0 else 5.8,
+                            loc="upper left" if col == 0 else "upper right")
         axes[1, col].legend(fontsize=7, loc="lower right")
         for row in range(2):
             axes[row, col].set_xlabel("follower i")
@@ -187,7 +188,7 @@ def plot(rows, runs, path):
     for row in range(2):
         axes[row, 0].set_yscale("log")
     axes[0, 0].set_ylim(1e-2, 1e16)
-    axes[0, 1].set_ylim(0.0, 1.3 * runs[right[0]]["followers"][0]["xi_max"])
+    axes[0, 1].set_ylim(0.0, 1.6 * runs[right[0]]["followers"][0]["xi_max"])
     axes[1, 1].set_ylim(0.0, 5.5)
     axes[0, 0].set_ylabel("m")
     axes[1, 0].set_ylabel("m (below 1e-7 drawn at 1e-7)")
@@ -246,7 +247,11 @@ def main(argv=None):
             "(peak_N / peak_2)^(1/(N−2)), the mean factor per follower behind follower 1 (the "
             "only one that sees the push itself). *Link*: the target's acceleration delayed "
             "and lost as [math.md (L1)–(L3)](math.md#the-link-of-shared-information) describe "
-            "(seed 1), the last value held; *same tick*: without delay or loss.", ""]
+            "(seed 1), the last value held; *same tick*: without delay or loss. *Leader stops*: "
+            "after the push the leader brakes back to rest (u_1 = 1 m/s² for 23 s ≤ t < 29 s); "
+            "otherwise it keeps reversing at 6 m/s, and with the time headway h every slot sits "
+            "h · 6 m/s closer for good (1.8 m at h = 0.3 s), which is then the peak of most "
+            "followers of the chosen configuration.", ""]
     text += summary_table(rows, runs, n) + [""]
     text += ["## Per follower", ""]
     text += follower_table(rows, runs, paper, "max_xi", "xi_max",
