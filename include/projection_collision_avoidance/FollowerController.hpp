@@ -15,15 +15,14 @@ template <typename Dims>
 struct FollowerControllerStatus {
   /// u_2 = baseline + tracker + feed-forward, saturated, then rate limited
   typename Dims::InputVector command;
-  typename Dims::InputVector baseline_command;  ///< G y (2)
-  typename Dims::InputVector tracker_command;   ///< u_a (19)
-  typename Dims::InputVector
-      feedforward_command;                      ///< u_ff (S2) when shared into the command, else 0
-  typename Dims::InputVector headway_command;   ///< K_h x_2 (S1); 0 without the time headway
-  typename Dims::InputVector fallback_command;  ///< K_f xi_hat in the fallback, else 0
-  typename Dims::StateVector estimate;          ///< xi_hat used at this tick (m)
-  double estimate_norm = 0.0;                   ///< ||xi_hat|| (m), euclideanNorm()
-  double constraint_value = 0.0;                ///< f(xi_hat) (13)
+  typename Dims::InputVector baseline_command;     ///< G y (2)
+  typename Dims::InputVector tracker_command;      ///< u_a (19)
+  typename Dims::InputVector feedforward_command;  ///< u_ff (S2) if shared in the command, else 0
+  typename Dims::InputVector headway_command;      ///< K_h x_2 (S1); 0 without the time headway
+  typename Dims::InputVector fallback_command;     ///< K_f xi_hat in the fallback, else 0
+  typename Dims::StateVector estimate;             ///< xi_hat used at this tick (m)
+  double estimate_norm = 0.0;                      ///< ||xi_hat|| (m), euclideanNorm()
+  double constraint_value = 0.0;                   ///< f(xi_hat) (13)
   bool command_saturated = false;  ///< the sum exceeded acceleration_limit and was scaled
   /// The saturated command was more than jerk_limit T from the previous one and was moved to
   /// that distance from it.
@@ -122,7 +121,7 @@ class FollowerController {
   }
 
   /// step(y) with the follower's own state x_2, from which the time headway (S1) acts (when
-  /// time_headway > 0; a non-finite x_2 leaves it out for this tick).
+  /// time_headway > 0; a non-finite x_2 leaves it out for this tick, and so does step()).
   const FollowerControllerStatus<Dims>& stepWithOwnState(const OutputVector& y,
                                                          const StateVector& own_state) {
     return tick(&y, InputVector::Zero(input_matrix_.cols()), false, &own_state);

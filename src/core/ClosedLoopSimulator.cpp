@@ -19,15 +19,21 @@
 namespace projection_collision_avoidance {
 namespace {
 
-/// ||p_a - p_b|| over the first k (position) entries.
+/// ||p_a - p_b||^2 over the first k (position) entries.
 template <typename Vector>
-double positionDistance(const Vector& a, const Vector& b, int k) {
+double squaredPositionDistance(const Vector& a, const Vector& b, int k) {
   double squared = 0.0;
   for (int i = 0; i < k; ++i) {
     const double delta = a(i) - b(i);
     squared += delta * delta;
   }
-  return std::sqrt(squared);
+  return squared;
+}
+
+/// ||p_a - p_b|| over the first k (position) entries.
+template <typename Vector>
+double positionDistance(const Vector& a, const Vector& b, int k) {
+  return std::sqrt(squaredPositionDistance(a, b, k));
 }
 
 /// One follower of the run: its controller, its plant and its figures.
@@ -91,7 +97,7 @@ FormationSummary runFormation(const Scenario& scenario, const ControllerDesign& 
                                use_link ? n_agents : 0, InputVector::Zero(m));
 
   FormationSummary formation;
-  formation.min_pair_separation = std::numeric_limits<double>::infinity();
+  double min_pair_squared = std::numeric_limits<double>::infinity();
   const long last_tick = std::lround(scenario.duration * p.control_rate);
   for (long tick = 0; tick <= last_tick; ++tick) {
     const double t = static_cast<double>(tick) / p.control_rate;
@@ -159,13 +165,15 @@ FormationSummary runFormation(const Scenario& scenario, const ControllerDesign& 
         observer(follower.member.index - 1, sample);
       }
     }
+    // Squared distances, one square root at the end: sqrt is monotonic and correctly rounded,
+    // so the minimum is the same double.
     for (std::size_t a = 0; a < followers.size(); ++a) {
       const StateVector& x_a = followers[a].plant.state();
-      formation.min_pair_separation =
-          std::min(formation.min_pair_separation, positionDistance(x_a, leader.state(), k));
+      min_pair_squared =
+          std::min(min_pair_squared, squaredPositionDistance(x_a, leader.state(), k));
       for (std::size_t b = a + 1; b < followers.size(); ++b) {
-        formation.min_pair_separation = std::min(
-            formation.min_pair_separation, positionDistance(x_a, followers[b].plant.state(), k));
+        min_pair_squared =
+            std::min(min_pair_squared, squaredPositionDistance(x_a, followers[b].plant.state(), k));
       }
     }
     if (tick < last_tick) {
@@ -175,6 +183,7 @@ FormationSummary runFormation(const Scenario& scenario, const ControllerDesign& 
       }
     }
   }
+  formation.min_pair_separation = std::sqrt(min_pair_squared);
   for (const SimulatedFollower<Dims>& follower : followers) {
     formation.followers.push_back(follower.summary);
   }

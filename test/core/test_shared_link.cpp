@@ -307,5 +307,18 @@ TEST(OptionsOff, AFormationWithAnIdealLinkIsTheSameTickChain) {
             same_tick.summary.followers.back().max_xi + 1e-6);
 }
 
+TEST(LinkInTheLoop, TheSameSeedGivesTheSameRun) {
+  const auto run = [](int seed) {
+    return trace("platoon_run2.yaml",
+                 {"formation.followers=10", "simulation.duration=30",
+                  "controller.leader_information.link.seed=" + std::to_string(seed)});
+  };
+  const Trace a = run(3);
+  expectIdentical(a, run(3));
+  const Trace b = run(4);
+  ASSERT_EQ(a.values.size(), b.values.size());
+  EXPECT_NE(a.values, b.values);  // other losses, another run
+}
+
 }  // namespace
 }  // namespace projection_collision_avoidance
