@@ -12,8 +12,8 @@
 #   string_stability.csv       peak ||xi_i||, bound, min separation and perimeter per follower
 #   string_stability.png       peak ||xi_i|| and min separation against i
 #   string_stability_gamma.png |Gamma(e^{jwT})| against w (scripts/string_stability_analysis.py)
-# Usage: scripts/string_stability.sh [OUT_DIR]   (about a minute; cf_sim 100 followers at 1 kHz
-#   takes a few seconds a run). Builds first (BUILD_DIR as for scripts/build.sh), unless
+# Usage: scripts/string_stability.sh [OUT_DIR]   (about 35 s after the build: 40 cf_sim runs, up
+#   to 1 s each, and the analysis). Builds first (BUILD_DIR as for scripts/build.sh), unless
 #   CF_SIM=path/to/cf_sim is given.
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
