@@ -122,8 +122,8 @@ def ratio(x):
 
 
 def summary_table(rows, runs, n):
-    lines = ["| # | configuration | peak ‖ξ_1‖ | peak ‖ξ_N‖ | growth per follower, i ≥ 2 "
-             "| max peak_{i+1}/peak_i | first out of ξ_max | first inside perimeter "
+    lines = ["| # | configuration | peak ‖ξ_1‖ | peak ‖ξ_N‖ | growth per follower "
+             "| max peak_i / peak_target | first out of ξ_max | first inside perimeter "
              "| first within 1 mm | min pair separation (m) | verdict |",
              "|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---|"]
     for k, (row, run) in enumerate(zip(rows, runs), 1):
@@ -243,9 +243,11 @@ def main(argv=None):
             "shorter chain: a chain of N is unsafe exactly when N reaches the first failing "
             "follower.", "",
             "Peak ‖ξ_i‖ = max_t ‖x_target − x_i − d_i‖ at the ticks; ξ_max,i = (1 − α)‖d_i‖ and "
-            "the perimeter α‖d_i‖ (4 m and 1 m in a chain, i times that in a star). *Growth*: "
-            "(peak_N / peak_2)^(1/(N−2)), the mean factor per follower behind follower 1 (the "
-            "only one that sees the push itself). *Link*: the target's acceleration delayed "
+            "the perimeter α‖d_i‖ (4 m and 1 m in a chain, i times that in a star). Peak *ratios* "
+            "go from a follower's target to the follower: peak_i / peak_{i−1} in a line chain, "
+            "along each arm in a V chain; a star has none. *Growth*: their geometric mean "
+            "behind the followers that see the push itself, (peak_N / peak_2)^(1/(N−2)) in a "
+            "line chain. *Link*: the target's acceleration delayed "
             "and lost as [math.md (L1)–(L3)](math.md#the-link-of-shared-information) describe "
             "(seed 1), the last value held; *same tick*: without delay or loss. *Leader stops*: "
             "after the push the leader brakes back to rest (u_1 = 1 m/s² for 23 s ≤ t < 29 s); "

@@ -12,7 +12,7 @@
 #   string_stability.csv       peak ||xi_i||, bound, min separation and perimeter per follower
 #   string_stability.png       peak ||xi_i|| and min separation against i
 #   string_stability_gamma.png |Gamma(e^{jwT})| against w (scripts/string_stability_analysis.py)
-# Usage: scripts/string_stability.sh [OUT_DIR]   (about 35 s after the build: 40 cf_sim runs, up
+# Usage: scripts/string_stability.sh [OUT_DIR]   (about 35 s after the build: 44 cf_sim runs, up
 #   to 1 s each, and the analysis). Builds first (BUILD_DIR as for scripts/build.sh), unless
 #   CF_SIM=path/to/cf_sim is given.
 set -euo pipefail
@@ -73,8 +73,22 @@ runs+=("chosen|100|chain|false|link|0.1|0.2|$platoon|$(link 0.1 0.2)")
 runs+=("chosen|100|star|true|link|0.1|0.2|$platoon|$(link 0.1 0.2)")
 for rate in 100 1000; do
   for delay in 0.1 0.2; do
-    runs+=("chosen, leader stops|$rate|chain|true|link|$delay|0.2|$platoon|$stop$(link "$delay" 0.2)")
+    arguments=$stop$(link "$delay" 0.2)
+    runs+=("chosen, leader stops|$rate|chain|true|link|$delay|0.2|$platoon|$arguments")
   done
+done
+# The 2-D and 3-D figure eights (the leader loops at up to 2.3 m/s and is pushed back at 2 m/s):
+# a line chain and a V chain of each, the paper's laws and the chosen options added by --set.
+chosen_options=$(set_ controller.spacing.time_headway=0.3 "$info.command=true" \
+  "$info.estimator=true" "$info.disturbance=true" "$info.feedforward.gain=0.7" \
+  "$info.feedforward.time_constant=0.2")
+for eight in 2d:line 3d:v; do
+  file=config/scenarios/figure_eight_${eight%:*}.yaml
+  shape=$(set_ "formation.shape=${eight#*:}")
+  name="figure eight ${eight%:*}, ${eight#*:}"
+  runs+=("paper, $name|100|chain|true|none|-|-|$file|$shape")
+  arguments=$shape$chosen_options$(link 0.1 0.2)
+  runs+=("chosen, $name|100|chain|true|link|0.1|0.2|$file|$arguments")
 done
 # The headway alone, nothing shared (ACC): 0.3 s is not enough, 1 s is too much for a reversal.
 for headway in 0.3 1.0; do
@@ -94,6 +108,7 @@ for i in "${!runs[@]}"; do
     <<<"${runs[$i]}"
   common=$(set_ "controller.control_rate=$rate" "formation.followers=$followers" \
     "formation.topology=$topology" "formation.shape=line" "controller.tracker.enabled=$tracker")
+  # (a later --set formation.shape in the run's own arguments overrides the line)
   IFS=';' read -ra argv <<<"$common$arguments"
   "$CF_SIM" "$scenario" "${argv[@]}" >"$work/$i.txt"
   # The arguments as a shell would take them, for the report.

@@ -43,6 +43,7 @@ struct SimulationSummary {
 /// The figures of a formation's run.
 struct FormationSummary {
   std::vector<SimulationSummary> followers;  ///< follower i at i - 1, against its own target
+  std::vector<int> targets;  ///< target of follower i at i - 1: 0 the leader, j follower j
   /// min ||p_a - p_b|| over every pair of agents, the leader included (m): pairs that are not
   /// leader and follower of each other are not protected by the method, only reported.
   double min_pair_separation = 0.0;

@@ -42,8 +42,8 @@ struct ControllerParameters {
   double feedforward_gain = 1.0;
   /// tau (s) of the shaped feed-forward's first-order low-pass (S2); 0: none.
   double feedforward_time_constant = 0.0;
-  /// h (s) of the constant time-headway spacing policy (S1): the slot moves h (r . v_2) further
-  /// back along r = d_p / ||d_p||; 0: the paper's constant d. Double integrators only.
+  /// h (s) of the constant time-headway spacing policy (S1): the slot moves back by h v_2, the
+  /// follower's velocity; 0: the paper's constant d. Double integrators only.
   double time_headway = 0.0;
   /// Bound on the command's norm ||u_2|| (m/s^2 for double integrators); a larger command is
   /// scaled onto it. Infinity: no bound.

@@ -21,9 +21,9 @@ namespace projection_collision_avoidance {
 void validatePlatoonParameters(const ControllerParameters& parameters);
 
 /// The gain K_h (m x n) of the time-headway term of the command, (S1):
-///   u_h = K_h x_2,   K_h = -G C M,   M = [[0, h P], [0, 0]],   P = r r^T,  r = d_p / ||d_p||,
-/// with x_2 the follower's own state, d_p the position part of d and h = time_headway (s). The
-/// follower regulates xi - M x_2 (its slot moved h (r . v_2) further back along r) while the CF
+///   u_h = K_h x_2,   K_h = -G C M,   M = [[0, h I], [0, 0]],
+/// with x_2 = [p_2; v_2] the follower's own state and h = time_headway (s). The follower
+/// regulates xi - M x_2 (its slot moved back by h v_2, along its velocity) while the CF
 /// estimator keeps the paper's xi = x_1 - x_2 - d and its bound. Zero when h = 0.
 /// @param parameters validated (validatePlatoonParameters() and the matrices' sizes)
 /// @throws ParameterError("controller.spacing.time_headway") when the follower's own loop

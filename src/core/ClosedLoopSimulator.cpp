@@ -186,6 +186,7 @@ FormationSummary runFormation(const Scenario& scenario, const ControllerDesign& 
   formation.min_pair_separation = std::sqrt(min_pair_squared);
   for (const SimulatedFollower<Dims>& follower : followers) {
     formation.followers.push_back(follower.summary);
+    formation.targets.push_back(follower.member.target);
   }
   return formation;
 }

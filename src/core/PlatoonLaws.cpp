@@ -12,13 +12,11 @@ namespace {
 constexpr double kMaxTimeHeadway = 100.0;            // s
 constexpr double kMaxFeedforwardTimeConstant = 1e3;  // s
 
-/// M = [[0, h P], [0, 0]] (n x n) of (S1) for a double integrator.
+/// M = [[0, h I], [0, 0]] (n x n) of (S1) for a double integrator.
 Eigen::MatrixXd headwayShift(const ControllerParameters& p) {
   const Eigen::Index k = p.model.position_dimension;
-  const Eigen::VectorXd position = p.separation.head(k);
-  const Eigen::VectorXd r = position / position.norm();
   Eigen::MatrixXd shift = Eigen::MatrixXd::Zero(p.model.stateDimension(), p.model.stateDimension());
-  shift.block(0, k, k, k) = p.time_headway * r * r.transpose();
+  shift.block(0, k, k, k).diagonal().setConstant(p.time_headway);
   return shift;
 }
 

@@ -11,6 +11,9 @@ namespace projection_collision_avoidance {
 StringStabilityFigures stringStabilityFigures(const FormationSummary& summary) {
   const std::vector<SimulationSummary>& followers = summary.followers;
   const std::size_t n = followers.size();
+  const auto target = [&summary](std::size_t i) {  // of follower i + 1, 1-based (0: leader)
+    return summary.targets.empty() ? static_cast<int>(i) : summary.targets[i];
+  };
   constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
   StringStabilityFigures figures;
   bool negligible = false;
@@ -25,18 +28,24 @@ StringStabilityFigures stringStabilityFigures(const FormationSummary& summary) {
     }
     negligible = negligible || !(f.max_xi >= StringStabilityFigures::kNegligiblePeak);
   }
-  figures.peak_ratio_max = n >= 2 && !negligible ? 0.0 : kNaN;
-  if (!std::isnan(figures.peak_ratio_max)) {
-    for (std::size_t i = 0; i + 1 < n; ++i) {
-      figures.peak_ratio_max =
-          std::max(figures.peak_ratio_max, followers[i + 1].max_xi / followers[i].max_xi);
+  double ratio_max = -1.0;
+  double log_sum = 0.0;
+  int behind = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const int t = target(i);
+    if (t < 1) {
+      continue;
+    }
+    const auto j = static_cast<std::size_t>(t - 1);
+    const double ratio = followers[i].max_xi / followers[j].max_xi;
+    ratio_max = std::max(ratio_max, ratio);
+    if (target(j) >= 1) {
+      log_sum += std::log(ratio);
+      ++behind;
     }
   }
-  figures.peak_growth = kNaN;
-  if (n >= 3 && !negligible) {
-    figures.peak_growth =
-        std::pow(followers[n - 1].max_xi / followers[1].max_xi, 1.0 / static_cast<double>(n - 2));
-  }
+  figures.peak_ratio_max = ratio_max >= 0.0 && !negligible ? ratio_max : kNaN;
+  figures.peak_growth = behind > 0 && !negligible ? std::exp(log_sum / behind) : kNaN;
   return figures;
 }
 

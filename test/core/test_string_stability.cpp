@@ -38,23 +38,22 @@ TEST(FeedforwardFilter, IsTheFirstOrderLowPassOfS2) {
   EXPECT_EQ(none.apply(0.3 * one)(0), 0.3);
 }
 
-TEST(TimeHeadway, GainShiftsThePositionPartAlongTheSeparation) {
+TEST(TimeHeadway, GainMovesTheSlotBackAlongTheVelocity) {
   ControllerParameters p = testing::paperParameters();
   p.time_headway = 0.3;
   // 1-D: K_h = -G M = -[k_p, k_v] [[0, h], [0, 0]] = [0, -k_p h].
   EXPECT_TRUE(timeHeadwayGain(p).isApprox(Eigen::RowVector2d(0.0, -0.3), 1e-15));
-  // 2-D, d along x: only the velocity along x moves the slot, and only along x.
+  // 2-D: the slot moves back by h v whatever the direction of v; positions play no part.
   ControllerParameters q = p;
   q.model = makeDoubleIntegrator(2);
   q.separation = Eigen::Vector4d(3.0, 4.0, 0.0, 0.0);
   q.baseline_gain = doubleIntegratorGain(Eigen::Vector2d(1.0, 2.0), Eigen::Vector2d(0.7, 0.7), "g");
   const Eigen::MatrixXd K = timeHeadwayGain(q);
-  const Eigen::Vector2d r(0.6, 0.8);
-  Eigen::Vector4d state(0.0, 0.0, -0.8, 0.6);  // velocity across d: no headway
-  EXPECT_NEAR((K * state).norm(), 0.0, 1e-15);
-  state.tail(2) = 2.0 * r;  // 2 m/s toward the target: slot 0.6 m further back along r
-  const Eigen::Vector2d expected = -q.baseline_gain.leftCols(2) * (0.6 * r);
-  EXPECT_TRUE((K * state).isApprox(expected, 1e-14));
+  for (const Eigen::Vector2d& v : {Eigen::Vector2d(-0.8, 0.6), Eigen::Vector2d(1.2, 1.6)}) {
+    const Eigen::Vector4d state(7.0, -2.0, v(0), v(1));
+    const Eigen::Vector2d expected = -q.baseline_gain.leftCols(2) * (0.3 * v);
+    EXPECT_TRUE((K * state).isApprox(expected, 1e-14)) << v.transpose();
+  }
   p.time_headway = 0.0;
   EXPECT_EQ(timeHeadwayGain(p).norm(), 0.0);
 }
@@ -190,8 +189,11 @@ TEST(StringStability, TheDefaultChainIsDetectedUnstable) {
       scenarioPath("paper_run2.yaml"),
       {"controller.control_rate=100", "formation.followers=30", "formation.topology=star"}));
   const StringStabilityFigures star_figures = stringStabilityFigures(star);
-  EXPECT_NEAR(star_figures.peak_ratio_max, 1.0, 1e-9);
+  EXPECT_TRUE(std::isnan(star_figures.peak_ratio_max));  // no follower looks at a follower
   EXPECT_EQ(star_figures.first_outside_bound, 0);
+  for (const SimulationSummary& f : star.followers) {
+    EXPECT_NEAR(f.max_xi, star.followers.front().max_xi, 1e-9);
+  }
 }
 
 TEST(StringStability, FiguresOfHandMadeSummaries) {
@@ -208,8 +210,16 @@ TEST(StringStability, FiguresOfHandMadeSummaries) {
   EXPECT_EQ(figures.first_outside_bound, 4);
   EXPECT_EQ(figures.first_inside_perimeter, 4);  // 0 < 1
   EXPECT_DOUBLE_EQ(figures.peak_ratio_max, 2.0);
-  EXPECT_DOUBLE_EQ(figures.peak_growth, std::sqrt(2.5));  // (5 / 2)^(1 / 2)
-  summary.followers[2].max_xi = 1e-12;                    // rounding noise: no ratio
+  EXPECT_NEAR(figures.peak_growth, std::sqrt(2.5), 1e-15);  // (5 / 2)^(1 / 2)
+  // A V chain: followers 1 and 2 see the leader, 3 looks at 1 and 4 at 2.
+  summary.targets = {0, 0, 1, 2};
+  const StringStabilityFigures v = stringStabilityFigures(summary);
+  EXPECT_DOUBLE_EQ(v.peak_ratio_max, 2.5);  // 5 / 2
+  EXPECT_TRUE(std::isnan(v.peak_growth));   // nobody behind a follower's follower
+  summary.targets = {0, 0, 0, 0};           // a star: nothing is passed on
+  EXPECT_TRUE(std::isnan(stringStabilityFigures(summary).peak_ratio_max));
+  summary.targets.clear();
+  summary.followers[2].max_xi = 1e-12;  // rounding noise: no ratio
   EXPECT_TRUE(std::isnan(stringStabilityFigures(summary).peak_ratio_max));
   summary.followers.resize(1);
   EXPECT_TRUE(std::isnan(stringStabilityFigures(summary).peak_growth));
