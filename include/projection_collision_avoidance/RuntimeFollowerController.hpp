@@ -16,7 +16,8 @@ struct RuntimeFollowerStatus {
   Eigen::VectorXd command;              ///< u_2
   Eigen::VectorXd baseline_command;     ///< G y (2)
   Eigen::VectorXd tracker_command;      ///< u_a (19)
-  Eigen::VectorXd feedforward_command;  ///< u_1 when shared into the command
+  Eigen::VectorXd feedforward_command;  ///< u_ff (S2) when shared into the command
+  Eigen::VectorXd headway_command;      ///< K_h x_2 (S1); 0 without the time headway
   Eigen::VectorXd fallback_command;     ///< K_f xi_hat in the fallback, else 0
   Eigen::VectorXd estimate;             ///< xi_hat used at this tick (m)
   double estimate_norm = 0.0;           ///< ||xi_hat|| (m)
@@ -49,6 +50,18 @@ class RuntimeFollowerController {
   /// One control period with the leader's input u_1 (inputDimension() entries).
   const RuntimeFollowerStatus& step(const Eigen::Ref<const Eigen::VectorXd>& y,
                                     const Eigen::Ref<const Eigen::VectorXd>& leader_input);
+
+  /// step(y) with the follower's own state x_2 (stateDimension() entries, m and m/s), from which
+  /// the time headway acts: u_2 = G y + u_a + u_ff + K_h x_2 (S1). A non-finite x_2 leaves the
+  /// headway out for this tick, as step(y) does.
+  const RuntimeFollowerStatus& stepWithOwnState(const Eigen::Ref<const Eigen::VectorXd>& y,
+                                                const Eigen::Ref<const Eigen::VectorXd>& own_state);
+
+  /// step(y, u_1) with the follower's own state x_2, as stepWithOwnState(y, x_2).
+  const RuntimeFollowerStatus& stepWithOwnState(
+      const Eigen::Ref<const Eigen::VectorXd>& y,
+      const Eigen::Ref<const Eigen::VectorXd>& own_state,
+      const Eigen::Ref<const Eigen::VectorXd>& leader_input);
 
   /// One control period without a measurement (see FollowerController::stepFallback()).
   const RuntimeFollowerStatus& stepFallback();

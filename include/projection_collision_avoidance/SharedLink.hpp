@@ -56,6 +56,19 @@ std::uint64_t splitMix64(std::uint64_t x);
 /// @param tick j >= 0, below 2^40
 bool linkMessageLost(std::uint64_t seed, int receiver, long tick, double dropout);
 
+/// What the receiving end of a link does with one message, for a link between processes (the
+/// ROS link_relay) that must lose and delay exactly what the sampled run's SharedLink does.
+struct LinkVerdict {
+  long tick = 0;         ///< j = round(stamp f): the sender's control tick
+  bool lost = false;     ///< (L2) for (receiver, j)
+  double release = 0.0;  ///< s: stamp + D / f, when the receiver may read it (L1)
+};
+
+/// The verdict on a message stamped @p stamp s (the sender's tick time, >= 0) on the link to
+/// follower @p receiver at @p control_rate f (Hz): j = round(stamp f), lost as (L2), released at
+/// stamp + D / f with D = spec.totalDelayPeriods(f). A negative stamp counts as tick 0.
+LinkVerdict judgeLinkMessage(const LinkSpec& spec, double control_rate, int receiver, double stamp);
+
 /// The values in flight on the links of a formation and what each follower holds, (L3): at tick
 /// k follower i reads the message its target sent at tick j = k - D; if j >= 0 and that message
 /// is not lost (L2), it replaces the held value; the follower uses the held value, zero until a

@@ -14,6 +14,7 @@ void copyStatus(const FollowerControllerStatus<Dims>& from, RuntimeFollowerStatu
   to->baseline_command = from.baseline_command;
   to->tracker_command = from.tracker_command;
   to->feedforward_command = from.feedforward_command;
+  to->headway_command = from.headway_command;
   to->fallback_command = from.fallback_command;
   to->estimate = from.estimate;
   to->estimate_norm = from.estimate_norm;
@@ -46,6 +47,7 @@ RuntimeFollowerController::RuntimeFollowerController(const ControllerDesign& des
   status_.baseline_command = Eigen::VectorXd::Zero(m);
   status_.tracker_command = Eigen::VectorXd::Zero(m);
   status_.feedforward_command = Eigen::VectorXd::Zero(m);
+  status_.headway_command = Eigen::VectorXd::Zero(m);
   status_.fallback_command = Eigen::VectorXd::Zero(m);
   status_.estimate = Eigen::VectorXd::Zero(n);
 }
@@ -71,6 +73,35 @@ const RuntimeFollowerStatus& RuntimeFollowerController::step(
         const typename Controller::OutputVector measurement = y;
         const typename Controller::InputVector input = leader_input;
         copyStatus(controller.step(measurement, input), &status_);
+      },
+      controller_);
+  return status_;
+}
+
+const RuntimeFollowerStatus& RuntimeFollowerController::stepWithOwnState(
+    const Eigen::Ref<const Eigen::VectorXd>& y,
+    const Eigen::Ref<const Eigen::VectorXd>& own_state) {
+  std::visit(
+      [&](auto& controller) {
+        using Controller = std::decay_t<decltype(controller)>;
+        const typename Controller::OutputVector measurement = y;
+        const typename Controller::StateVector state = own_state;
+        copyStatus(controller.stepWithOwnState(measurement, state), &status_);
+      },
+      controller_);
+  return status_;
+}
+
+const RuntimeFollowerStatus& RuntimeFollowerController::stepWithOwnState(
+    const Eigen::Ref<const Eigen::VectorXd>& y, const Eigen::Ref<const Eigen::VectorXd>& own_state,
+    const Eigen::Ref<const Eigen::VectorXd>& leader_input) {
+  std::visit(
+      [&](auto& controller) {
+        using Controller = std::decay_t<decltype(controller)>;
+        const typename Controller::OutputVector measurement = y;
+        const typename Controller::StateVector state = own_state;
+        const typename Controller::InputVector input = leader_input;
+        copyStatus(controller.stepWithOwnState(measurement, state, input), &status_);
       },
       controller_);
   return status_;

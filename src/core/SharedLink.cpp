@@ -68,4 +68,15 @@ bool linkMessageLost(std::uint64_t seed, int receiver, long tick, double dropout
   return uniform < dropout;
 }
 
+LinkVerdict judgeLinkMessage(const LinkSpec& spec, double control_rate, int receiver,
+                             double stamp) {
+  LinkVerdict verdict;
+  const double tick = std::round(stamp * control_rate);
+  constexpr double kLastTick = static_cast<double>(1L << kReceiverShift) - 1.0;
+  verdict.tick = tick > 0.0 ? static_cast<long>(std::min(tick, kLastTick)) : 0;  // NaN: 0
+  verdict.lost = linkMessageLost(spec.seed, receiver, verdict.tick, spec.dropout);
+  verdict.release = stamp + spec.totalDelayPeriods(control_rate) / control_rate;
+  return verdict;
+}
+
 }  // namespace projection_collision_avoidance

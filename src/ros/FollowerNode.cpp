@@ -93,6 +93,7 @@ FollowerNodeOptions readOptions(NodeOptionReader& reader, const ControllerParame
   options.use_leader_broadcast = reader.boolean("use_leader_broadcast", false);
   options.measurement_frame = reader.text("measurement_frame", "");
   options.leader_broadcast_frame = reader.text("leader_broadcast_frame", "");
+  options.odom_frame = reader.text("odom_frame", "");
   options.follower_frame = reader.text("follower_frame", member.name);
   if (options.follower_frame.empty()) {
     throw ParameterError("~follower_frame", "must not be empty");
@@ -155,6 +156,8 @@ FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh, const
   leader_guard_ = InputGuard(
       "leader_broadcast",
       {options_.leader_broadcast_frame, options_.max_future_stamp, options_.leader_timeout});
+  own_state_guard_ = InputGuard(
+      "odom", {options_.odom_frame, options_.max_future_stamp, options_.measurement_timeout});
   const std::string name = private_nh_.getNamespace();
   echoScenario(name, private_nh);
   reader.echo(name);
@@ -162,6 +165,7 @@ FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh, const
   period_ = 1.0 / parameters_.control_rate;
   relative_state_ = Eigen::VectorXd::Zero(2 * axes_);
   leader_input_ = Eigen::VectorXd::Zero(axes_);
+  own_state_ = Eigen::VectorXd::Zero(2 * axes_);
   command_publisher_ = nh_.advertise<geometry_msgs::AccelStamped>("command", 10);
   broadcast_publisher_ = nh_.advertise<LeaderBroadcast>("broadcast", 10);
   status_publisher_ = nh_.advertise<FollowerStatus>("status", 10);
@@ -170,6 +174,10 @@ FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh, const
                                           this, ros::TransportHints().tcpNoDelay());
   leader_subscriber_ =
       nh_.subscribe("leader_broadcast", 10, &FollowerNode::onLeaderBroadcast, this);
+  if (parameters_.time_headway > 0.0) {
+    odometry_subscriber_ = nh_.subscribe("odom", 10, &FollowerNode::onOdometry, this,
+                                         ros::TransportHints().tcpNoDelay());
+  }
 
   diagnostics_.setHardwareID(options_.follower_frame);
   diagnostics_.add("follower controller", this, &FollowerNode::diagnose);
@@ -208,7 +216,11 @@ FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh, const
                        << parameters_.separation.transpose() << "], running at "
                        << parameters_.control_rate << " Hz (trigger: " << toString(options_.trigger)
                        << loop.str() << "), " << axes_ << " axes, xi_max "
-                       << controller_.design().xi_max << " m");
+                       << controller_.design().xi_max << " m"
+                       << (parameters_.time_headway > 0.0
+                               ? ", time headway " + std::to_string(parameters_.time_headway) +
+                                     " s from " + odometry_subscriber_.getTopic()
+                               : std::string()));
 }
 
 FollowerNode::~FollowerNode() {
@@ -263,6 +275,21 @@ void FollowerNode::onLeaderBroadcast(const LeaderBroadcast::ConstPtr& msg) {
   });
 }
 
+void FollowerNode::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  admitGuarded(own_state_guard_, private_nh_.getNamespace(), [&] {
+    const ros::Time now = ros::Time::now();
+    if (!admitHeader(own_state_guard_, msg->header, now)) {
+      return;
+    }
+    if (!stateFromOdometryMsg(*msg, axes_, &own_state_)) {
+      own_state_guard_.reject(Rejection::kContent, "non-finite position or velocity");
+      return;
+    }
+    own_state_guard_.accept(nanosecondsOf(msg->header.stamp), nanosecondsOf(now));
+  });
+}
+
 bool FollowerNode::admitHeader(InputGuard& guard, const std_msgs::Header& header,
                                const ros::Time& now) {
   if (clock_.wentBack(now)) {
@@ -278,6 +305,7 @@ void FollowerNode::onTimeJump(const ros::Time& now) {
                      "measurements arrive");
   measurement_guard_.restartTimeline();
   leader_guard_.restartTimeline();
+  own_state_guard_.restartTimeline();
   have_last_expected_ = false;
 }
 
@@ -412,13 +440,22 @@ void FollowerNode::controlStep(const ros::Time& stamp, double delay) {
   leader_fresh_ = ages.have_leader && ages.leader_age <= options_.leader_timeout;
   const bool use_leader_input = options_.use_leader_broadcast && leader_fresh_;
   const Eigen::VectorXd xi = relative_state_ - parameters_.separation;
+  // The time headway (S1) acts from the own odometry while it is fresh; without it the tick runs
+  // the paper's constant spacing.
+  own_state_fresh_ = parameters_.time_headway > 0.0 && own_state_guard_.everAccepted() &&
+                     own_state_guard_.ageAt(nanosecondsOf(stamp)) <= options_.measurement_timeout;
   const RuntimeFollowerStatus* status = nullptr;
   if (mode == FollowerMode::kMeasurementLost) {
     status =
         use_leader_input ? &controller_.stepFallback(leader_input_) : &controller_.stepFallback();
   } else {
     const Eigen::VectorXd y = parameters_.model.C * xi;
-    status = use_leader_input ? &controller_.step(y, leader_input_) : &controller_.step(y);
+    if (own_state_fresh_) {
+      status = use_leader_input ? &controller_.stepWithOwnState(y, own_state_, leader_input_)
+                                : &controller_.stepWithOwnState(y, own_state_);
+    } else {
+      status = use_leader_input ? &controller_.step(y, leader_input_) : &controller_.step(y);
+    }
   }
   command_publisher_.publish(toAccelMsg(status->command, stamp, options_.follower_frame));
   LeaderBroadcast broadcast;  // for a follower behind this one: its acceleration, no state
@@ -427,7 +464,7 @@ void FollowerNode::controlStep(const ros::Time& stamp, double delay) {
   broadcast.input = toStdVector(status->command);
   broadcast_publisher_.publish(broadcast);
   last_xi_norm_ = xi.norm();
-  publishStatus(stamp, xi, ages.measurement_age);
+  publishStatus(stamp, xi, ages);
   const std::uint64_t ticks_per_marker =
       options_.marker_rate > 0.0
           ? static_cast<std::uint64_t>(
@@ -440,7 +477,7 @@ void FollowerNode::controlStep(const ros::Time& stamp, double delay) {
 }
 
 void FollowerNode::publishStatus(const ros::Time& now, const Eigen::VectorXd& xi,
-                                 double measurement_age) {
+                                 const FollowerInputAges& ages) {
   const RuntimeFollowerStatus& s = controller_.status();
   const ControllerDesign& design = controller_.design();
   FollowerStatus msg;
@@ -452,9 +489,10 @@ void FollowerNode::publishStatus(const ros::Time& now, const Eigen::VectorXd& xi
   msg.mode_name = toString(mode_);
   msg.fallback = s.fallback;
   msg.measurement_fresh = mode_ == FollowerMode::kTracking || mode_ == FollowerMode::kLeaderLost;
-  msg.measurement_age = measurement_age;
+  msg.measurement_age = ages.measurement_age;
   msg.rejected_measurements = measurement_guard_.rejected();
   msg.leader_fresh = leader_fresh_;
+  msg.leader_age = ages.have_leader ? ages.leader_age : std::numeric_limits<double>::infinity();
   msg.rejected_leader_broadcasts = leader_guard_.rejected();
   msg.xi = toStdVector(xi);
   msg.xi_hat = toStdVector(s.estimate);
@@ -474,6 +512,8 @@ void FollowerNode::publishStatus(const ros::Time& now, const Eigen::VectorXd& xi
   msg.baseline_command = toStdVector(s.baseline_command);
   msg.tracker_command = toStdVector(s.tracker_command);
   msg.feedforward_command = toStdVector(s.feedforward_command);
+  msg.headway_command = toStdVector(s.headway_command);
+  msg.own_state_fresh = own_state_fresh_;
   msg.fallback_command = toStdVector(s.fallback_command);
   msg.separation = relative_state_.head(axes_).norm();
   msg.perimeter = design.perimeter;
@@ -582,6 +622,9 @@ void FollowerNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
   status.add("tracker_gain", gain.str());
   status.add("rejected_measurements", measurement_guard_.rejected());
   status.add("rejected_leader_broadcasts", leader_guard_.rejected());
+  status.add("time_headway (s)", parameters_.time_headway);
+  status.add("own_state_fresh", own_state_fresh_);
+  status.add("rejected_odometry", own_state_guard_.rejected());
   const std::int64_t now_ns = nanosecondsOf(ros::Time::now());
   status.add("measurement_age (s)",
              measurement_guard_.haveAccepted() ? measurement_guard_.ageAt(now_ns) : -1.0);

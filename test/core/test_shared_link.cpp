@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -121,6 +122,41 @@ TEST(SharedLink, HoldsTheLastDeliveredValue) {
     EXPECT_EQ(link.receive(1, 2, tick)(0), expected) << tick;
   }
   EXPECT_GT(holds, 800);  // the reference really held values over losses
+}
+
+TEST(SharedLink, VerdictsOnStampedMessagesReproduceTheSampledLink) {
+  // A process that gets each message with its stamp (the ROS link_relay) and releases it at
+  // verdict.release, unless lost, delivers at tick k what SharedLink::receive() holds at k.
+  LinkSpec spec;
+  spec.configured = true;
+  spec.delay_periods = 1;
+  spec.latency = 0.1;
+  spec.dropout = 0.2;
+  spec.seed = 9;
+  const double rate = 100.0;
+  SharedLink<Value> link(spec, rate, 2, 4, value(0.0));
+  std::vector<std::pair<double, double>> in_flight;  // (release, value)
+  double held = 0.0;
+  long lost = 0;
+  for (long tick = 0; tick < 3000; ++tick) {
+    const double now = static_cast<double>(tick) / rate;
+    const double sent = std::cos(0.05 * static_cast<double>(tick));
+    link.send(0, tick, value(sent));
+    const LinkVerdict verdict = judgeLinkMessage(spec, rate, 3, now);
+    ASSERT_EQ(verdict.tick, tick);
+    lost += verdict.lost ? 1 : 0;
+    if (!verdict.lost) {
+      in_flight.emplace_back(verdict.release, sent);
+    }
+    while (!in_flight.empty() && in_flight.front().first <= now + 1e-9 / rate) {
+      held = in_flight.front().second;
+      in_flight.erase(in_flight.begin());
+    }
+    ASSERT_EQ(link.receive(3, 0, tick)(0), held) << "tick " << tick;
+  }
+  EXPECT_GT(lost, 450);  // 20 % of 3000: the losses were exercised
+  EXPECT_EQ(judgeLinkMessage(spec, rate, 3, -1.0).tick, 0);
+  EXPECT_EQ(judgeLinkMessage(spec, rate, 3, std::nan("")).tick, 0);
 }
 
 TEST(LinkKeys, AreReadAndRefusedNamingTheKey) {

@@ -9,6 +9,7 @@
 #include <boost/thread/recursive_mutex.hpp>
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <dynamic_reconfigure/server.h>
+#include <nav_msgs/Odometry.h>
 #include <ros/callback_queue.h>
 #include <ros/ros.h>
 
@@ -55,6 +56,7 @@ struct FollowerNodeOptions {
   bool use_leader_broadcast = false;   ///< use u_1 from leader_broadcast (always monitored)
   std::string measurement_frame;       ///< required frame_id of measurements ("" = any)
   std::string leader_broadcast_frame;  ///< required frame_id of leader broadcasts ("" = any)
+  std::string odom_frame;              ///< required frame_id of the own odometry ("" = any)
   std::string follower_frame;  ///< frame of the command, status and markers (default: the name)
   double marker_rate = 10.0;   ///< Hz
   int formation_index = 1;     ///< i: which follower of the scenario's formation this is
@@ -75,7 +77,9 @@ struct FollowerNodeOptions {
 /// keeps the separation d_i of its slot to its target (the leader, or the follower ahead of it in
 /// a chain). Subscribes `relative_measurement` (RelativeMeasurement, x_target - x_i) and
 /// `leader_broadcast` (LeaderBroadcast of the target: monitored always, its acceleration u_1, plus
-/// pinv(B) u_d with controller.leader_information.disturbance, used with ~use_leader_broadcast).
+/// pinv(B) u_d with controller.leader_information.disturbance, used with ~use_leader_broadcast)
+/// and, with a time headway (controller.spacing.time_headway > 0), `odom` (nav_msgs/Odometry:
+/// its own state x_i, from which the headway term K_h x_i of (S1) acts).
 /// At each control step (see ~trigger below) it picks the mode from the inputs' ages
 /// (selectFollowerMode()): with a fresh measurement it runs the controller on
 /// y = C (x_target - x_i - d_i), with a stale one the braking fallback; then it publishes
@@ -129,6 +133,7 @@ class FollowerNode {
  private:
   void onMeasurement(const RelativeMeasurement::ConstPtr& msg);
   void onLeaderBroadcast(const LeaderBroadcast::ConstPtr& msg);
+  void onOdometry(const nav_msgs::Odometry::ConstPtr& msg);
   /// The timer's tick ("timer" loop).
   void onControlTick(const ros::TimerEvent& event);
   /// The control thread's tick ("thread" loop).
@@ -147,7 +152,8 @@ class FollowerNode {
   bool admitHeader(InputGuard& guard, const std_msgs::Header& header, const ros::Time& now);
   /// ROS time went back to @p now (mutex_ held): forget the inputs of the old timeline.
   void onTimeJump(const ros::Time& now);
-  void publishStatus(const ros::Time& now, const Eigen::VectorXd& xi, double measurement_age);
+  void publishStatus(const ros::Time& now, const Eigen::VectorXd& xi,
+                     const FollowerInputAges& ages);
   void publishMarkers(const ros::Time& now, const Eigen::VectorXd& xi);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
   FollowerConfig configOf(const ControllerParameters& parameters) const;
@@ -170,6 +176,9 @@ class FollowerNode {
   InputGuard measurement_guard_;
   Eigen::VectorXd leader_input_;  ///< a_1 of the latest accepted leader broadcast
   InputGuard leader_guard_;
+  Eigen::VectorXd own_state_;  ///< x_i of the latest accepted own odometry (time headway only)
+  InputGuard own_state_guard_;
+  bool own_state_fresh_ = false;
   ClockWatch clock_;                     ///< jumps back of ROS time
   bool resuming_ = false;                ///< a stall was seen; waiting for input (see controlTick)
   ros::Time resumed_at_;                 ///< when the stall was seen
@@ -187,6 +196,7 @@ class FollowerNode {
 
   ros::Subscriber measurement_subscriber_;
   ros::Subscriber leader_subscriber_;
+  ros::Subscriber odometry_subscriber_;  ///< only with a time headway (S1)
   ros::Publisher command_publisher_;
   ros::Publisher broadcast_publisher_;
   ros::Publisher status_publisher_;
