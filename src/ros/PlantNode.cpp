@@ -74,6 +74,14 @@ PlantNodeOptions readOptions(NodeOptionReader& reader, const Scenario& scenario)
                          "must lie in (0, 1000], got " + std::to_string(o.real_time_factor));
   }
   o.duration = reader.number("duration", 0.0, 0.0, 1e7);
+  o.wait_for_followers = reader.number("wait_for_followers", 0.0, 0.0, 3600.0);
+  o.lockstep = reader.boolean("lockstep", false);
+  o.lockstep_timeout = reader.number("lockstep_timeout", o.lockstep_timeout, 0.001, 3600.0);
+  if (o.lockstep && !o.publish_clock) {
+    throw ParameterError("~lockstep",
+                         "is true but ~publish_clock is false: only a plant that drives "
+                         "simulated time can wait for the commands");
+  }
   return o;
 }
 
@@ -171,6 +179,7 @@ PlantNode::PlantNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
     origin_ = ros::Time(0);
     wall_origin_ = ros::WallTime::now();
     rate_check_wall_ = wall_origin_;
+    waiting_for_followers_ = options_.wait_for_followers > 0.0;
     wall_timer_ =
         nh_.createWallTimer(ros::WallDuration(1.0 / (options_.rate * options_.real_time_factor)),
                             &PlantNode::onWallTick, this);
@@ -236,6 +245,29 @@ void PlantNode::onWallTick(const ros::WallTimerEvent& /*event*/) {
   // (simulated time slows down) and reported below.
   const double wall_rate = options_.rate * options_.real_time_factor;
   const ros::WallTime now = ros::WallTime::now();
+  if (waiting_for_followers_) {
+    // Simulated time starts once every follower listens, or ~wait_for_followers s after start.
+    int listening = 0;
+    for (const Follower& follower : followers_) {
+      listening += follower.measurement_publisher.getNumSubscribers() > 0 ? 1 : 0;
+    }
+    const double waited = (now - wall_origin_).toSec();
+    const bool all = listening == static_cast<int>(followers_.size());
+    if (!all && waited < options_.wait_for_followers) {
+      return;
+    }
+    waiting_for_followers_ = false;
+    if (all) {
+      ROS_INFO_STREAM(name_ << ": every follower listens after " << waited
+                            << " s: simulated time starts");
+    } else {
+      ROS_WARN_STREAM(name_ << ": " << listening << " of " << followers_.size()
+                            << " followers listen after ~wait_for_followers = " << waited
+                            << " s: simulated time starts without the others");
+    }
+    wall_origin_ = now;
+    rate_check_wall_ = now;
+  }
   long due =
       static_cast<long>(std::floor((now - wall_origin_).toSec() * wall_rate + kTickTolerance));
   const long max_catch_up = std::max(1L, std::lround(kMaxCatchUp * wall_rate));
@@ -244,6 +276,23 @@ void PlantNode::onWallTick(const ros::WallTimerEvent& /*event*/) {
     wall_origin_ = now - ros::WallDuration(static_cast<double>(next_tick_) / wall_rate);
   }
   while (running_ && next_tick_ <= due) {
+    if (options_.lockstep && next_tick_ > 0 && !commandsAnswer(next_tick_ - 1)) {
+      if (!holding_) {
+        holding_ = true;
+        hold_start_ = now;
+      }
+      if ((now - hold_start_).toSec() < options_.lockstep_timeout) {
+        // Simulated time waits: the wall schedule restarts from here.
+        wall_origin_ = now - ros::WallDuration(static_cast<double>(next_tick_) / wall_rate);
+        break;
+      }
+      ++lockstep_timeouts_;
+      ROS_WARN_STREAM_THROTTLE(5.0, name_ << ": lockstep: tick " << next_tick_ << " waited "
+                                          << options_.lockstep_timeout
+                                          << " s for the commands and runs without them ("
+                                          << lockstep_timeouts_ << " such ticks)");
+    }
+    holding_ = false;
     running_ = tick(next_tick_);
     ++next_tick_;
   }
@@ -312,7 +361,9 @@ void PlantNode::rosTick() {
 }
 
 bool PlantNode::tick(long k) {
-  const double t = static_cast<double>(k) / options_.rate;
+  if (options_.lockstep && k > 0) {
+    advanceAll(k - 1);  // [t_k-1, t_k] with the commands that answered sample k - 1
+  }
   const ros::Time stamp = stampOf(k);
 
   // Sample: odometry, tf, relative measurements.
@@ -347,12 +398,31 @@ bool PlantNode::tick(long k) {
     return false;
   }
 
-  // Integrate every agent to t_{k+1} with its command held; the leader under u_d.
+  if (!options_.lockstep) {
+    advanceAll(k);  // in lockstep tick k + 1 does it, once the answers to sample k are in
+  }
+  return true;
+}
+
+void PlantNode::advanceAll(long k) {
+  const double t = static_cast<double>(k) / options_.rate;
+  const ros::Time stamp = stampOf(k);
   advanceAgent(&leader_, t, stamp);
   for (Follower& follower : followers_) {
     advanceAgent(&follower.agent, t, stamp);
   }
-  return true;
+}
+
+bool PlantNode::commandsAnswer(long k) const {
+  const std::int64_t due = nanosecondsOf(stampOf(k));
+  const auto answered = [due](const Agent& agent) {
+    return !agent.command_guard.haveAccepted() || agent.command_guard.lastStamp() >= due;
+  };
+  if (!answered(leader_)) {
+    return false;
+  }
+  return std::all_of(followers_.begin(), followers_.end(),
+                     [&](const Follower& follower) { return answered(follower.agent); });
 }
 
 void PlantNode::advanceAgent(Agent* agent, double t, const ros::Time& stamp) {

@@ -37,6 +37,14 @@ struct PlantNodeOptions {
   bool publish_clock = false;     ///< drive the ticks on wall time and publish /clock
   double real_time_factor = 1.0;  ///< simulated s per wall s with publish_clock
   double duration = 0.0;          ///< s of simulated time, then shut down; 0 = forever
+  /// Wall s for which, with publish_clock, simulated time stays at its start until every
+  /// follower subscribes its relative_measurement (a large formation loading); 0 = no wait.
+  double wait_for_followers = 0.0;
+  /// With publish_clock: tick k + 1 waits (wall time, at most lockstep_timeout s) until every
+  /// agent that has commanded answered tick k with a command stamped t_k, and integrates
+  /// [t_k, t_k+1] with those commands: the sampled loop of cf_sim, however loaded the machine.
+  bool lockstep = false;
+  double lockstep_timeout = 1.0;  ///< wall s a tick waits for the commands in lockstep
 };
 
 /// The simulated world: the leader and its followers, double integrators integrated exactly by
@@ -106,6 +114,10 @@ class PlantNode {
   void publishMeasurement(Follower* follower, long k, const ros::Time& stamp);
   /// Publishes the command the agent's tick k at time t (s) integrates, and integrates it.
   void advanceAgent(Agent* agent, double t, const ros::Time& stamp);
+  /// Integrates every agent over [t_k, t_k+1] with its command held; the leader under u_d.
+  void advanceAll(long k);
+  /// Lockstep: whether every agent that has commanded has a command stamped at or after t_k.
+  bool commandsAnswer(long k) const;
   void publishMarkers(const ros::Time& stamp);
   /// The agent a follower is measured against.
   const Agent& targetOf(const Follower& follower) const;
@@ -136,6 +148,10 @@ class PlantNode {
   bool running_ = true;
   ros::Time origin_;           ///< ROS time of scenario time 0
   ros::WallTime wall_origin_;  ///< wall time of tick 0 (publish_clock)
+  bool waiting_for_followers_ = false;  ///< holding simulated time (~wait_for_followers)
+  bool holding_ = false;               ///< lockstep: a tick waits for commands since hold_start_
+  ros::WallTime hold_start_;
+  std::uint64_t lockstep_timeouts_ = 0;  ///< ticks that ran without every command
   ros::WallTime rate_check_wall_;
   long rate_check_tick_ = 0;
 
