@@ -146,10 +146,10 @@ class PlantNode {
   long ticks_per_marker_ = 1;
   bool started_ = false;
   bool running_ = true;
-  ros::Time origin_;           ///< ROS time of scenario time 0
-  ros::WallTime wall_origin_;  ///< wall time of tick 0 (publish_clock)
+  ros::Time origin_;                    ///< ROS time of scenario time 0
+  ros::WallTime wall_origin_;           ///< wall time of tick 0 (publish_clock)
   bool waiting_for_followers_ = false;  ///< holding simulated time (~wait_for_followers)
-  bool holding_ = false;               ///< lockstep: a tick waits for commands since hold_start_
+  bool holding_ = false;                ///< lockstep: a tick waits for commands since hold_start_
   ros::WallTime hold_start_;
   std::uint64_t lockstep_timeouts_ = 0;  ///< ticks that ran without every command
   ros::WallTime rate_check_wall_;
