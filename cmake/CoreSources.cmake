@@ -15,17 +15,21 @@ set(PCA_CORE_SOURCES
   src/core/FollowerMode.cpp
   src/core/Formation.cpp
   src/core/LinearAlgebra.cpp
+  src/core/PlatoonLaws.cpp
   src/core/RuntimeFollowerController.cpp
   src/core/Scenario.cpp
   src/core/ScenarioEmbedding.cpp
+  src/core/SharedLink.cpp
   src/core/SignalProfile.cpp
   src/core/SimulationCsvWriter.cpp
+  src/core/StringStability.cpp
 )
 
 # projection_collision_avoidance_scenario: scenario files (libyaml parses them into yaml-cpp
 # trees) and the cf_sim command.
 set(PCA_SCENARIO_SOURCES
   src/scenario/CfSimApp.cpp
+  src/scenario/ControllerReader.cpp
   src/scenario/ScenarioLoader.cpp
   src/scenario/YamlParser.cpp
 )

@@ -21,10 +21,10 @@ summary=$(rosrun "$package" cf_sim "$share/config/scenarios/paper_run2.yaml") ||
   fail "rosrun $package cf_sim failed"
 [[ $summary == *min_separation=* ]] || fail "cf_sim printed no summary: $summary"
 echo "rosrun cf_sim: $summary"
-for node in follower_node leader_node plant_node; do
+for node in follower_node leader_node plant_node link_relay; do
   catkin_find --first-only --libexec "$package" "$node" >/dev/null || fail "no $node"
 done
-echo "nodes: follower_node leader_node plant_node found"
+echo "nodes: follower_node leader_node plant_node link_relay found"
 plugins=$(rospack plugins --attrib=plugin nodelet | grep "^$package ") ||
   fail "the nodelet plugins are not exported"
 echo "nodelet plugins: ${plugins#"$package "}"

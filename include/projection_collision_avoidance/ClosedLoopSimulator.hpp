@@ -43,6 +43,7 @@ struct SimulationSummary {
 /// The figures of a formation's run.
 struct FormationSummary {
   std::vector<SimulationSummary> followers;  ///< follower i at i - 1, against its own target
+  std::vector<int> targets;  ///< target of follower i at i - 1: 0 the leader, j follower j
   /// min ||p_a - p_b|| over every pair of agents, the leader included (m): pairs that are not
   /// leader and follower of each other are not protected by the method, only reported.
   double min_pair_separation = 0.0;
@@ -56,10 +57,13 @@ using FormationObserver = std::function<void(int member, const SimulationSample&
 /// Runs the closed loop of a scenario's formation without ROS: at each tick t_k = k /
 /// control_rate, for k = 0 .. round(duration * control_rate), every follower i in index order
 /// steps on y_i = C (x_target - x_i - d_i); then every agent is integrated exactly to t_{k+1},
-/// inputs held, the leader's step split at disturbance pulse edges. With leader information
-/// (controller.leader_information) a follower of the leader is given a_1 = u_1(t_k) (+ pinv(B)
-/// u_d(t_k) when the disturbance is shared), and a follower of follower j the command follower j
-/// computed at the same tick. Throws ParameterError for an invalid scenario.
+/// inputs held, the leader's step split at disturbance pulse edges. Each follower is given its own
+/// state x_i for the time headway (S1). With leader information (controller.leader_information)
+/// a follower of the leader is given a_1 = u_1(t_k) (+ pinv(B) u_d(t_k) when the disturbance is
+/// shared), and a follower of follower j the command follower j computed at the same tick; with
+/// a link section, these values as the link delivers them instead ((L1)-(L3): delayed by D
+/// periods, lost with probability dropout, the last one held). Throws ParameterError for an
+/// invalid scenario.
 FormationSummary simulateFormation(const Scenario& scenario,
                                    const FormationObserver& observer = {});
 

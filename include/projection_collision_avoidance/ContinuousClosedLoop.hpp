@@ -40,7 +40,8 @@ struct ContinuousLoopSignals {
 /// sat() is the controller's: none unless controller.acceleration_limit is set. The same
 /// equations as FollowerController, except that u_a and y are not held over a period. The
 /// controller's rate limit (controller.jerk_limit), a bound per control period, has no
-/// counterpart here and is refused.
+/// counterpart here and is refused, and so are the time headway (S1) and the shaped feed-forward
+/// (S2), which only the sampled loop models.
 template <typename Dims>
 class ContinuousClosedLoop {
  public:
@@ -51,7 +52,8 @@ class ContinuousClosedLoop {
   using Signals = ContinuousLoopSignals<Dims>;
 
   /// @param design validated parameters whose sizes fit Dims (std::invalid_argument otherwise),
-  ///        without a jerk_limit (ParameterError("controller.jerk_limit") otherwise)
+  ///        without a jerk_limit, time_headway or shaped feed-forward (ParameterError naming the
+  ///        key otherwise)
   explicit ContinuousClosedLoop(const ControllerDesign& design)
       : constraint_(design.xi_max, design.parameters.epsilon),
         acceleration_limit_(design.parameters.acceleration_limit),
@@ -67,6 +69,14 @@ class ContinuousClosedLoop {
       throw ParameterError("controller.jerk_limit",
                            "the continuous-time loop has no control period to limit the "
                            "command's change over; remove the key or run the sampled loop");
+    }
+    const ControllerParameters& p = design.parameters;
+    if (p.time_headway != 0.0 || p.feedforward_gain != 1.0 || p.feedforward_time_constant != 0.0) {
+      throw ParameterError(p.time_headway != 0.0 ? "controller.spacing.time_headway"
+                           : p.feedforward_gain != 1.0
+                               ? "controller.leader_information.feedforward.gain"
+                               : "controller.leader_information.feedforward.time_constant",
+                           "is modelled by the sampled loop only (cf_sim without --continuous)");
     }
     state_matrix_ = model.A;
     input_matrix_ = model.B;

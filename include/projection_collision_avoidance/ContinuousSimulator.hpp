@@ -24,7 +24,8 @@ enum class ContinuousMethod {
 /// @param step h (s): finite, > 0, and duration / h a whole number (within 1e-9)
 /// @param method the Runge-Kutta method
 /// @throws ParameterError naming "step" for a bad step, "formation.followers" for more than
-///         one follower, or the key of an invalid scenario entry
+///         one follower, the key of a link that delays or loses (controller.leader_information
+///         .link.*), of a time headway or shaped feed-forward, or of an invalid scenario entry
 SimulationSummary simulateContinuous(const Scenario& scenario, double step,
                                      const SampleObserver& observer = {},
                                      ContinuousMethod method = ContinuousMethod::kRungeKutta4);

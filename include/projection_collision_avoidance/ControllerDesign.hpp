@@ -25,6 +25,8 @@ struct ControllerDesign {
   Eigen::MatrixXd input_pseudoinverse;   ///< pinv(B), m x n: the acceleration part of u_d
   Eigen::MatrixXd fallback_gain;         ///< K_f, m x n (parameters.fallback_gain or its default)
   Eigen::MatrixXd fallback_matrix;       ///< A - B K_f: the predicted xi' in the fallback
+  Eigen::MatrixXd headway_gain;          ///< K_h = -G C M of the time headway (S1), m x n
+  double feedforward_smoothing = 0.0;    ///< a = exp(-T / tau) of the shaped feed-forward (S2)
   /// Decay rate mu = lambda_min(Q) / (2 lambda_max(Gamma)) of Theorem 3.1: ||e(t)|| <=
   /// K_0 e^{-mu t / 2} ||e(0)|| with K_0 = sqrt(lambda_max(Gamma) / lambda_min(Gamma)).
   double estimator_decay_rate = 0.0;
@@ -35,7 +37,7 @@ struct ControllerDesign {
   /// acceleration_limit and jerk_limit > 0 (or infinite), d != 0 and A d = 0, control_rate > 0,
   /// substeps in [1, 1000], Q = Q^T > 0, and A_c, A_c + L C, A_c - B G_e C Hurwitz (the message
   /// lists the eigenvalues), K_f of size m x n, finite, with no eigenvalue of A - B K_f in the open
-  /// right half-plane.
+  /// right half-plane, and the string-stability options (validatePlatoonParameters()).
   static ControllerDesign create(const ControllerParameters& parameters);
 
   /// The leader's acceleration as shared with the follower: a_1 = u_1 + pinv(B) u_d when

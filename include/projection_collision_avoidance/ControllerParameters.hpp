@@ -38,6 +38,13 @@ struct ControllerParameters {
   /// pinv(B) u_d. The rest of u_d, (I - B pinv(B)) u_d (the position-rate part of a double
   /// integrator's), is outside the range of B: no input can cancel it.
   bool leader_disturbance_shared = false;
+  /// kappa of the shaped feed-forward (S2), in [0, 1]: u_ff scales the shared acceleration.
+  double feedforward_gain = 1.0;
+  /// tau (s) of the shaped feed-forward's first-order low-pass (S2); 0: none.
+  double feedforward_time_constant = 0.0;
+  /// h (s) of the constant time-headway spacing policy (S1): the slot moves back by h v_2, the
+  /// follower's velocity; 0: the paper's constant d. Double integrators only.
+  double time_headway = 0.0;
   /// Bound on the command's norm ||u_2|| (m/s^2 for double integrators); a larger command is
   /// scaled onto it. Infinity: no bound.
   double acceleration_limit = std::numeric_limits<double>::infinity();

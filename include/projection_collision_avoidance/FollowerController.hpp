@@ -5,6 +5,7 @@
 #include "projection_collision_avoidance/CollisionFreeTracker.hpp"
 #include "projection_collision_avoidance/CommandRateLimiter.hpp"
 #include "projection_collision_avoidance/ControllerDesign.hpp"
+#include "projection_collision_avoidance/PlatoonLaws.hpp"
 #include "projection_collision_avoidance/TypeDefs.hpp"
 
 namespace projection_collision_avoidance {
@@ -16,7 +17,8 @@ struct FollowerControllerStatus {
   typename Dims::InputVector command;
   typename Dims::InputVector baseline_command;     ///< G y (2)
   typename Dims::InputVector tracker_command;      ///< u_a (19)
-  typename Dims::InputVector feedforward_command;  ///< u_1 when shared into the command, else 0
+  typename Dims::InputVector feedforward_command;  ///< u_ff (S2) if shared in the command, else 0
+  typename Dims::InputVector headway_command;      ///< K_h x_2 (S1); 0 without the time headway
   typename Dims::InputVector fallback_command;     ///< K_f xi_hat in the fallback, else 0
   typename Dims::StateVector estimate;             ///< xi_hat used at this tick (m)
   double estimate_norm = 0.0;                      ///< ||xi_hat|| (m), euclideanNorm()
@@ -53,6 +55,7 @@ struct FollowerControllerStatus {
     baseline_command = other.baseline_command;
     tracker_command = other.tracker_command;
     feedforward_command = other.feedforward_command;
+    headway_command = other.headway_command;
     fallback_command = other.fallback_command;
     estimate = other.estimate;
     estimate_norm = other.estimate_norm;
@@ -74,13 +77,14 @@ struct FollowerControllerStatus {
 /// tracks the CF estimator (11)-(15). One step() per control period T.
 ///
 /// At a tick with measurement y = C xi the command is
-///   u_2 = rate(sat(G y + u_a + u_ff)),   u_a = G_e (y - C xi_hat) + S_21 C xi_hat,
-/// computed from the current estimate, where sat() scales a vector longer than
+///   u_2 = rate(sat(G y + u_a + u_ff [+ K_h x_2])),   u_a = G_e (y - C xi_hat) + S_21 C xi_hat,
+/// computed from the current estimate (K_h x_2 the time headway (S1), given the own state x_2;
+/// u_ff the shared acceleration, shaped by (S2)), where sat() scales a vector longer than
 /// acceleration_limit onto it and rate() moves it to within jerk_limit T of the previous tick's
 /// command (CommandRateLimiter; zero before the first tick). The estimate is then integrated
 /// over [t, t + T] with y held and the augmentation that actually acts, u_2 - G y - u_ff (u_a
-/// when neither limit acted), so that its model of xi' stays that of the plant. Without a
-/// measurement stepFallback() brakes relative to the leader from the predicted estimate instead,
+/// [+ K_h x_2] when neither limit acted), so that its model of xi' stays that of the plant. Without
+/// a measurement stepFallback() brakes relative to the leader from the predicted estimate instead,
 /// under the same two limits, so that a change of mode cannot jump the command. A step allocates
 /// no memory.
 ///
@@ -107,6 +111,10 @@ class FollowerController {
         baseline_gain_(design.parameters.baseline_gain),
         output_pseudoinverse_(design.output_pseudoinverse),
         fallback_gain_(design.fallback_gain),
+        headway_gain_(design.headway_gain),
+        feedforward_filter_(design.parameters.feedforward_gain, design.feedforward_smoothing,
+                            design.parameters.model.inputDimension()),
+        headway_(design.parameters.time_headway > 0.0),
         rate_limiter_(design.parameters.jerk_limit, design.period,
                       design.parameters.acceleration_limit,
                       design.parameters.model.inputDimension()) {
@@ -114,6 +122,7 @@ class FollowerController {
     status_.baseline_command = status_.command;
     status_.tracker_command = status_.command;
     status_.feedforward_command = status_.command;
+    status_.headway_command = status_.command;
     status_.fallback_command = status_.command;
     status_.estimate = estimator_.estimate();
   }
@@ -141,6 +150,20 @@ class FollowerController {
     return tick(&y, leader_input, true);
   }
 
+  /// step(y) with the follower's own state x_2, from which the time headway (S1) acts (when
+  /// time_headway > 0; a non-finite x_2 leaves it out for this tick, and so does step()).
+  const FollowerControllerStatus<Dims>& stepWithOwnState(const OutputVector& y,
+                                                         const StateVector& own_state) {
+    return tick(&y, InputVector::Zero(input_matrix_.cols()), false, &own_state);
+  }
+
+  /// step(y, leader_input) with the follower's own state x_2, as stepWithOwnState(y, x_2).
+  const FollowerControllerStatus<Dims>& stepWithOwnState(const OutputVector& y,
+                                                         const StateVector& own_state,
+                                                         const InputVector& leader_input) {
+    return tick(&y, leader_input, true, &own_state);
+  }
+
   /// One control period without a measurement: the fallback. The command brakes relative to
   /// the leader from the estimate, which is predicted by the model alone and stays in Omega_1:
   ///   u_2 = rate(sat(u_ff + K_f xi_hat)),   xi_hat' = Proj(A xi_hat + B (u_1m - u_2)),
@@ -165,6 +188,7 @@ class FollowerController {
   void reset() {
     initialized_ = false;
     rate_limiter_.reset();
+    feedforward_filter_.reset();
   }
 
   /// Sets the estimate (projected into Omega_1; zero if not finite) and marks the controller
@@ -195,7 +219,8 @@ class FollowerController {
  private:
   /// One tick: checks the inputs, then runs the laws (y given and finite) or the fallback.
   const FollowerControllerStatus<Dims>& tick(const OutputVector* y, const InputVector& leader_input,
-                                             bool leader_input_known) {
+                                             bool leader_input_known,
+                                             const StateVector* own_state = nullptr) {
     status_.measurement_rejected = false;
     status_.leader_input_rejected = false;
     status_.command_overflow = false;
@@ -208,7 +233,8 @@ class FollowerController {
       status_.measurement_rejected = true;
       y = nullptr;
     }
-    if (y != nullptr && advance(*y, leader_input, leader_input_known)) {
+    setFeedforward(leader_input, leader_input_known);
+    if (y != nullptr && advance(*y, leader_input, leader_input_known, own_state)) {
       return status_;
     }
     return fallback(leader_input, leader_input_known);
@@ -232,7 +258,8 @@ class FollowerController {
 
   /// The laws for the finite y; false, with nothing changed but the initialisation and
   /// command_overflow set, if their command is not finite.
-  bool advance(const OutputVector& y, const InputVector& leader_input, bool leader_input_known) {
+  bool advance(const OutputVector& y, const InputVector& leader_input, bool leader_input_known,
+               const StateVector* own_state) {
     const ControllerParameters& p = design_.parameters;
     if (!initialized_) {
       initialize(y);
@@ -242,9 +269,14 @@ class FollowerController {
 
     status_.baseline_command = baseline_gain_ * y;
     status_.tracker_command = tracker_.command(y, estimated_output);
-    setFeedforward(leader_input, leader_input_known);
     status_.command =
         status_.baseline_command + status_.tracker_command + status_.feedforward_command;
+    const bool headway = headway_ && own_state != nullptr && own_state->allFinite();
+    status_.headway_command.setZero();
+    if (headway) {  // (S1)
+      status_.headway_command = headway_gain_ * (*own_state);
+      status_.command += status_.headway_command;
+    }
     if (!status_.command.allFinite()) {
       status_.command_overflow = true;
       return false;
@@ -256,6 +288,9 @@ class FollowerController {
     status_.fallback = false;
     limitCommand();
     InputVector acting_augmentation = status_.tracker_command;
+    if (headway) {
+      acting_augmentation += status_.headway_command;
+    }
     if (status_.command_saturated || status_.command_rate_limited) {
       acting_augmentation =
           status_.command - status_.baseline_command - status_.feedforward_command;
@@ -279,8 +314,8 @@ class FollowerController {
     status_.constraint_value = estimator_.constraint().value(estimate);
     status_.baseline_command.setZero();
     status_.tracker_command.setZero();
+    status_.headway_command.setZero();
     status_.fallback = true;
-    setFeedforward(leader_input, leader_input_known);
     status_.fallback_command = fallback_gain_ * estimate;
     status_.command = status_.feedforward_command + status_.fallback_command;
     if (!status_.command.allFinite()) {  // K_f xi_hat overflows: u_ff alone (finite)
@@ -309,10 +344,15 @@ class FollowerController {
     return StateVector::Zero(input_matrix_.rows());
   }
 
+  /// u_ff of this tick: the shared acceleration, shaped by (S2) when configured; 0 (and the
+  /// filter restarted) when it is unknown or not shared into the command.
   void setFeedforward(const InputVector& leader_input, bool leader_input_known) {
     status_.feedforward_command.setZero();
     if (leader_input_known && design_.parameters.leader_input_in_command) {
-      status_.feedforward_command = leader_input;
+      status_.feedforward_command =
+          feedforward_filter_.shapes() ? feedforward_filter_.apply(leader_input) : leader_input;
+    } else {
+      feedforward_filter_.reset();
     }
   }
 
@@ -333,6 +373,9 @@ class FollowerController {
   typename Dims::FeedbackGainMatrix baseline_gain_;         // G
   typename Dims::ObserverGainMatrix output_pseudoinverse_;  // pinv(C)
   typename Dims::StateGainMatrix fallback_gain_;            // K_f
+  typename Dims::StateGainMatrix headway_gain_;             // K_h (S1)
+  FeedforwardFilter<InputVector> feedforward_filter_;       // (S2)
+  bool headway_;                                            // time_headway > 0
   CommandRateLimiter<InputVector> rate_limiter_;            // jerk_limit, from u_2(k-1)
   FollowerControllerStatus<Dims> status_;
   bool initialized_ = false;

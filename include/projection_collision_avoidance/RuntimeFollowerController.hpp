@@ -32,6 +32,18 @@ class RuntimeFollowerController {
   const RuntimeFollowerStatus& step(const Eigen::Ref<const Eigen::VectorXd>& y,
                                     const Eigen::Ref<const Eigen::VectorXd>& leader_input);
 
+  /// step(y) with the follower's own state x_2 (stateDimension() entries, m and m/s), from which
+  /// the time headway acts: u_2 = G y + u_a + u_ff + K_h x_2 (S1). A non-finite x_2 leaves the
+  /// headway out for this tick, as step(y) does.
+  const RuntimeFollowerStatus& stepWithOwnState(const Eigen::Ref<const Eigen::VectorXd>& y,
+                                                const Eigen::Ref<const Eigen::VectorXd>& own_state);
+
+  /// step(y, u_1) with the follower's own state x_2, as stepWithOwnState(y, x_2).
+  const RuntimeFollowerStatus& stepWithOwnState(
+      const Eigen::Ref<const Eigen::VectorXd>& y,
+      const Eigen::Ref<const Eigen::VectorXd>& own_state,
+      const Eigen::Ref<const Eigen::VectorXd>& leader_input);
+
   /// One control period without a measurement (see FollowerController::stepFallback()).
   const RuntimeFollowerStatus& stepFallback();
 

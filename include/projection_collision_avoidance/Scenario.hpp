@@ -4,6 +4,7 @@
 
 #include "projection_collision_avoidance/ControllerParameters.hpp"
 #include "projection_collision_avoidance/Formation.hpp"
+#include "projection_collision_avoidance/SharedLink.hpp"
 #include "projection_collision_avoidance/SignalProfile.hpp"
 
 namespace projection_collision_avoidance {
@@ -19,10 +20,14 @@ struct Scenario {
   SignalProfile disturbance;               ///< u_d(t), n; x_1' = A x_1 + B u_1 + u_d
   double duration = 0.0;                   ///< s
   FormationSpec formation;                 ///< the followers; one ("follower") by default
+  /// The link of the shared accelerations (controller.leader_information.link); a sampled run
+  /// models it, the ROS nodes have a real one.
+  LinkSpec link;
 
   /// Checks the parts that ControllerDesign::create() does not: initial states, signals and
-  /// duration and formation. Throws ParameterError naming "leader.*", "follower.*",
-  /// "simulation.duration" or "formation.*".
+  /// duration, formation and link. Throws ParameterError naming "leader.*", "follower.*",
+  /// "simulation.duration", "formation.*" or "controller.leader_information.link[.*]" (a link
+  /// that carries nothing: neither command nor estimator shared).
   void validate() const;
 };
 

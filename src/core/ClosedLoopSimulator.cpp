@@ -14,19 +14,26 @@
 #include "projection_collision_avoidance/DimensionDispatch.hpp"
 #include "projection_collision_avoidance/FollowerController.hpp"
 #include "projection_collision_avoidance/ParameterError.hpp"
+#include "projection_collision_avoidance/SharedLink.hpp"
 
 namespace projection_collision_avoidance {
 namespace {
 
-/// ||p_a - p_b|| over the first k (position) entries.
+/// ||p_a - p_b||^2 over the first k (position) entries.
 template <typename Vector>
-double positionDistance(const Vector& a, const Vector& b, int k) {
+double squaredPositionDistance(const Vector& a, const Vector& b, int k) {
   double squared = 0.0;
   for (int i = 0; i < k; ++i) {
     const double delta = a(i) - b(i);
     squared += delta * delta;
   }
-  return std::sqrt(squared);
+  return squared;
+}
+
+/// ||p_a - p_b|| over the first k (position) entries.
+template <typename Vector>
+double positionDistance(const Vector& a, const Vector& b, int k) {
+  return std::sqrt(squaredPositionDistance(a, b, k));
 }
 
 /// One follower of the run: its controller, its plant and its figures.
@@ -71,6 +78,7 @@ FormationSummary runFormation(const Scenario& scenario, const ControllerDesign& 
   const std::vector<FormationMember> members =
       layoutFormation(scenario.formation, p.separation, scenario.leader_initial_state,
                       scenario.follower_initial_state);
+  const int n_agents = static_cast<int>(members.size()) + 1;
   std::vector<SimulatedFollower<Dims>> followers;
   followers.reserve(members.size());
   for (const FormationMember& member : members) {
@@ -82,9 +90,14 @@ FormationSummary runFormation(const Scenario& scenario, const ControllerDesign& 
   const bool share_disturbance = share_leader_input && p.leader_disturbance_shared;
   const bool need_disturbance = share_disturbance || static_cast<bool>(observer);
   const typename Dims::StateGainMatrix input_pseudoinverse = scenario_design.input_pseudoinverse;
+  // The link of the shared accelerations (L1)-(L3): agent 0 the leader, i follower i. Without a
+  // link section a follower gets its target's acceleration of the same tick.
+  const bool use_link = share_leader_input && scenario.link.configured;
+  SharedLink<InputVector> link(scenario.link, p.control_rate, use_link ? n_agents : 0,
+                               use_link ? n_agents : 0, InputVector::Zero(m));
 
   FormationSummary formation;
-  formation.min_pair_separation = std::numeric_limits<double>::infinity();
+  double min_pair_squared = std::numeric_limits<double>::infinity();
   const long last_tick = std::lround(scenario.duration * p.control_rate);
   for (long tick = 0; tick <= last_tick; ++tick) {
     const double t = static_cast<double>(tick) / p.control_rate;
@@ -98,18 +111,28 @@ FormationSummary runFormation(const Scenario& scenario, const ControllerDesign& 
     if (share_disturbance) {
       leader_acceleration += input_pseudoinverse * disturbance;
     }
+    if (use_link) {
+      link.send(0, tick, leader_acceleration);
+    }
     for (SimulatedFollower<Dims>& follower : followers) {
       const bool behind_leader = follower.member.target == 0;
       const SimulatedFollower<Dims>* ahead =
           behind_leader ? nullptr
                         : &followers[static_cast<std::size_t>(follower.member.target - 1)];
       const StateVector& target_state = behind_leader ? leader.state() : ahead->plant.state();
-      const InputVector& target_acceleration = behind_leader ? leader_acceleration : ahead->command;
+      const InputVector& target_acceleration =
+          use_link ? link.receive(follower.member.index, follower.member.target, tick)
+                   : (behind_leader ? leader_acceleration : ahead->command);
       const StateVector xi = target_state - follower.plant.state() - follower.separation;
       const OutputVector y = output_matrix * xi;
-      const auto& status = share_leader_input ? follower.controller.step(y, target_acceleration)
-                                              : follower.controller.step(y);
+      const StateVector& own_state = follower.plant.state();
+      const auto& status = share_leader_input ? follower.controller.stepWithOwnState(
+                                                    y, own_state, target_acceleration)
+                                              : follower.controller.stepWithOwnState(y, own_state);
       follower.command = status.command;
+      if (use_link) {
+        link.send(follower.member.index, tick, follower.command);
+      }
 
       SimulationSummary& summary = follower.summary;
       const double xi_norm = xi.norm();
@@ -142,13 +165,15 @@ FormationSummary runFormation(const Scenario& scenario, const ControllerDesign& 
         observer(follower.member.index - 1, sample);
       }
     }
+    // Squared distances, one square root at the end: sqrt is monotonic and correctly rounded,
+    // so the minimum is the same double.
     for (std::size_t a = 0; a < followers.size(); ++a) {
       const StateVector& x_a = followers[a].plant.state();
-      formation.min_pair_separation =
-          std::min(formation.min_pair_separation, positionDistance(x_a, leader.state(), k));
+      min_pair_squared =
+          std::min(min_pair_squared, squaredPositionDistance(x_a, leader.state(), k));
       for (std::size_t b = a + 1; b < followers.size(); ++b) {
-        formation.min_pair_separation = std::min(
-            formation.min_pair_separation, positionDistance(x_a, followers[b].plant.state(), k));
+        min_pair_squared =
+            std::min(min_pair_squared, squaredPositionDistance(x_a, followers[b].plant.state(), k));
       }
     }
     if (tick < last_tick) {
@@ -158,8 +183,10 @@ FormationSummary runFormation(const Scenario& scenario, const ControllerDesign& 
       }
     }
   }
+  formation.min_pair_separation = std::sqrt(min_pair_squared);
   for (const SimulatedFollower<Dims>& follower : followers) {
     formation.followers.push_back(follower.summary);
+    formation.targets.push_back(follower.member.target);
   }
   return formation;
 }

@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <string>
 #include <vector>
 
 #include "projection_collision_avoidance/ContinuousClosedLoop.hpp"
@@ -281,6 +282,14 @@ SimulationSummary simulateContinuous(const Scenario& scenario, double step,
   if (scenario.formation.followers != 1) {
     throw ParameterError("formation.followers",
                          "the continuous-time loop runs the pair (one follower)");
+  }
+  if (scenario.link.active()) {
+    const LinkSpec& link = scenario.link;
+    throw ParameterError(std::string("controller.leader_information.link.") +
+                             (link.delay_periods != 0 ? "delay_periods"
+                              : link.latency != 0.0   ? "latency"
+                                                      : "dropout"),
+                         "a link is modelled by the sampled loop only (no --continuous)");
   }
   if (!(std::isfinite(step) && step > 0.0 && step <= scenario.duration)) {
     throw ParameterError("step", "must be finite, > 0 and at most simulation.duration");

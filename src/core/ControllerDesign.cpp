@@ -11,6 +11,7 @@
 
 #include "projection_collision_avoidance/LinearAlgebra.hpp"
 #include "projection_collision_avoidance/ParameterError.hpp"
+#include "projection_collision_avoidance/PlatoonLaws.hpp"
 
 #include "ValidationChecks.hpp"
 
@@ -168,6 +169,7 @@ ControllerDesign ControllerDesign::create(const ControllerParameters& parameters
   validateAgentModel(p.model);
   validateScalars(p);
   validateSeparation(p);
+  validatePlatoonParameters(p);
 
   const Eigen::Index n = p.model.stateDimension();
   const Eigen::Index m = p.model.inputDimension();
@@ -243,6 +245,8 @@ ControllerDesign ControllerDesign::create(const ControllerParameters& parameters
     throw ParameterError("controller.leader_information.disturbance",
                          "shares nothing unless leader_information.command or .estimator is true");
   }
+  design.headway_gain = timeHeadwayGain(p);
+  design.feedforward_smoothing = feedforwardSmoothing(p);
   const double d_norm = p.separation.norm();
   design.xi_max = (1.0 - p.alpha) * d_norm;
   design.xi_soft = design.xi_max / std::sqrt(1.0 + p.epsilon);

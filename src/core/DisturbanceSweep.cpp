@@ -112,6 +112,13 @@ Scenario sweepScenario(const Scenario& base, const SweepConfiguration& configura
   p.leader_input_in_command = command;
   p.leader_input_in_estimator = estimator;
   p.leader_disturbance_shared = command || estimator;
+  if (!command) {  // a configuration that shares nothing into the command has nothing to shape
+    p.feedforward_gain = 1.0;
+    p.feedforward_time_constant = 0.0;
+  }
+  if (!command && !estimator) {  // nor a link to carry anything
+    scenario.link = LinkSpec();
+  }
   return scenario;
 }
 

@@ -30,6 +30,7 @@ RuntimeFollowerController::RuntimeFollowerController(const ControllerDesign& des
   status_.baseline_command.setZero(m);
   status_.tracker_command.setZero(m);
   status_.feedforward_command.setZero(m);
+  status_.headway_command.setZero(m);
   status_.fallback_command.setZero(m);
   status_.estimate.setZero(n);
 }
@@ -55,6 +56,35 @@ const RuntimeFollowerStatus& RuntimeFollowerController::step(
         const typename Controller::OutputVector measurement = y;
         const typename Controller::InputVector input = leader_input;
         copyStatus(controller.step(measurement, input), &status_);
+      },
+      controller_);
+  return status_;
+}
+
+const RuntimeFollowerStatus& RuntimeFollowerController::stepWithOwnState(
+    const Eigen::Ref<const Eigen::VectorXd>& y,
+    const Eigen::Ref<const Eigen::VectorXd>& own_state) {
+  std::visit(
+      [&](auto& controller) {
+        using Controller = std::decay_t<decltype(controller)>;
+        const typename Controller::OutputVector measurement = y;
+        const typename Controller::StateVector state = own_state;
+        copyStatus(controller.stepWithOwnState(measurement, state), &status_);
+      },
+      controller_);
+  return status_;
+}
+
+const RuntimeFollowerStatus& RuntimeFollowerController::stepWithOwnState(
+    const Eigen::Ref<const Eigen::VectorXd>& y, const Eigen::Ref<const Eigen::VectorXd>& own_state,
+    const Eigen::Ref<const Eigen::VectorXd>& leader_input) {
+  std::visit(
+      [&](auto& controller) {
+        using Controller = std::decay_t<decltype(controller)>;
+        const typename Controller::OutputVector measurement = y;
+        const typename Controller::StateVector state = own_state;
+        const typename Controller::InputVector input = leader_input;
+        copyStatus(controller.stepWithOwnState(measurement, state, input), &status_);
       },
       controller_);
   return status_;

@@ -84,9 +84,13 @@ void FollowerCycle::readInputs(std::int64_t now_ns) {
   if (leader_.read()) {
     ever_led_ = true;
   }
+  if (own_state_.read()) {
+    ever_own_state_ = true;
+  }
   // An input of the old timeline (received after now: ROS time went back) is not valid.
   have_measurement_ = ever_measured_ && measurement_.value().receipt_ns <= now_ns;
   have_leader_ = ever_led_ && leader_.value().receipt_ns <= now_ns;
+  have_own_state_ = ever_own_state_ && own_state_.value().receipt_ns <= now_ns;
 }
 
 bool FollowerCycle::tick(std::int64_t now_ns, double delay, std::uint32_t skipped,
@@ -189,14 +193,25 @@ bool FollowerCycle::step(std::int64_t now_ns, std::int64_t stamp_ns, double dela
   out->xi = state - separation_;
   const Eigen::Index axes = design.parameters.model.position_dimension;
   out->distance = state.head(axes).norm();
+  // The time headway (S1) acts from the own state while it is fresh; without it the step runs
+  // the paper's constant spacing.
+  const OwnStateSample& own = own_state_.value();
+  out->own_state_fresh =
+      design.parameters.time_headway > 0.0 && have_own_state_ &&
+      ageOf(stamp_ns, own.stamp_ns, own.receipt_ns) <= settings_.measurement_timeout;
   const RuntimeFollowerStatus* status = nullptr;
   if (mode_ == FollowerMode::kMeasurementLost) {
     status = use_leader ? &controller_->stepFallback(leader_.value().acceleration)
                         : &controller_->stepFallback();
   } else {
     y_.noalias() = design.parameters.model.C * out->xi;
-    status =
-        use_leader ? &controller_->step(y_, leader_.value().acceleration) : &controller_->step(y_);
+    const GenericDimensions::InputVector& a = leader_.value().acceleration;
+    if (out->own_state_fresh) {
+      status = use_leader ? &controller_->stepWithOwnState(y_, own.state, a)
+                          : &controller_->stepWithOwnState(y_, own.state);
+    } else {
+      status = use_leader ? &controller_->step(y_, a) : &controller_->step(y_);
+    }
   }
   out->stepped = true;
   out->stamp_ns = stamp_ns;
@@ -227,6 +242,7 @@ void FollowerCycle::fillCounters(std::int64_t now_ns, FollowerCycleOutput* out) 
   out->acceleration_limit = design.parameters.acceleration_limit;
   out->jerk_limit = design.parameters.jerk_limit;
   out->tracker_enabled = design.parameters.tracker_enabled;
+  out->time_headway = design.parameters.time_headway;
 }
 
 }  // namespace projection_collision_avoidance

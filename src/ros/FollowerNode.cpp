@@ -87,7 +87,11 @@ FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh,
                        << parameters.separation.transpose() << "], running at "
                        << parameters.control_rate << " Hz (trigger: " << toString(options.trigger)
                        << loop.str() << "), " << parameters.model.double_integrator_axes
-                       << " axes, xi_max " << start.xi_max << " m");
+                       << " axes, xi_max " << start.xi_max << " m"
+                       << (parameters.time_headway > 0.0
+                               ? ", time headway " + std::to_string(parameters.time_headway) +
+                                     " s from " + inputs_->odometryTopic()
+                               : std::string()));
 }
 
 FollowerNode::~FollowerNode() { stop(); }

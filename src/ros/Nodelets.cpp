@@ -1,4 +1,4 @@
-/// The three nodes as nodelets: each owns the same class the stand-alone node runs.
+/// The nodes as nodelets: each owns the same class the stand-alone node runs.
 
 #include <exception>
 #include <iostream>
@@ -11,6 +11,7 @@
 #include "projection_collision_avoidance/ScenarioLoader.hpp"
 #include "projection_collision_avoidance/ros/FollowerNode.hpp"
 #include "projection_collision_avoidance/ros/LeaderNode.hpp"
+#include "projection_collision_avoidance/ros/LinkRelay.hpp"
 #include "projection_collision_avoidance/ros/PlantNode.hpp"
 
 namespace projection_collision_avoidance {
@@ -43,9 +44,11 @@ class NodeletOf : public nodelet::Nodelet {
 class FollowerNodelet : public NodeletOf<FollowerNode> {};
 class LeaderNodelet : public NodeletOf<LeaderNode> {};
 class PlantNodelet : public NodeletOf<PlantNode> {};
+class LinkRelayNodelet : public NodeletOf<LinkRelay> {};
 
 }  // namespace projection_collision_avoidance
 
 PLUGINLIB_EXPORT_CLASS(projection_collision_avoidance::FollowerNodelet, nodelet::Nodelet)
 PLUGINLIB_EXPORT_CLASS(projection_collision_avoidance::LeaderNodelet, nodelet::Nodelet)
 PLUGINLIB_EXPORT_CLASS(projection_collision_avoidance::PlantNodelet, nodelet::Nodelet)
+PLUGINLIB_EXPORT_CLASS(projection_collision_avoidance::LinkRelayNodelet, nodelet::Nodelet)

@@ -19,6 +19,7 @@
 #include "projection_collision_avoidance/ParameterError.hpp"
 #include "projection_collision_avoidance/ScenarioLoader.hpp"
 #include "projection_collision_avoidance/SimulationCsvWriter.hpp"
+#include "projection_collision_avoidance/StringStability.hpp"
 
 namespace projection_collision_avoidance {
 namespace {
@@ -149,6 +150,36 @@ std::string csvPathOf(const std::string& path, const FormationMember& member, bo
   return result.string();
 }
 
+/// The first key set in @p scenario that only a sampled run models (the continuous-time loop
+/// has no control period, and no link, headway or feed-forward shaping), or "".
+std::string sampledOnlyKey(const Scenario& scenario) {
+  const ControllerParameters& p = scenario.controller;
+  const LinkSpec& link = scenario.link;
+  const std::string sharing = "controller.leader_information.";
+  if (std::isfinite(p.jerk_limit)) {
+    return "controller.jerk_limit";
+  }
+  if (p.time_headway != 0.0) {
+    return "controller.spacing.time_headway";
+  }
+  if (p.feedforward_gain != 1.0) {
+    return sharing + "feedforward.gain";
+  }
+  if (p.feedforward_time_constant != 0.0) {
+    return sharing + "feedforward.time_constant";
+  }
+  if (link.configured && link.delay_periods != 0) {
+    return sharing + "link.delay_periods";
+  }
+  if (link.configured && link.latency != 0.0) {
+    return sharing + "link.latency";
+  }
+  if (link.configured && link.dropout != 0.0) {
+    return sharing + "link.dropout";
+  }
+  return "";
+}
+
 /// Runs the scenario's formation (one follower without a formation section), writing the CSVs.
 int runSimulation(const Scenario& scenario, const Options& options, std::ostream& out,
                   std::ostream& err) {
@@ -217,6 +248,15 @@ int runSimulation(const Scenario& scenario, const Options& options, std::ostream
        << " shape=" << toString(scenario.formation.shape)
        << " min_pair_separation=" << summary.min_pair_separation << " wall_s=" << wall;
   out << last.str() << "\n";
+  const StringStabilityFigures figures = stringStabilityFigures(summary);
+  std::ostringstream string_line;
+  string_line.imbue(std::locale::classic());
+  string_line.precision(9);
+  string_line << "string_stability first_outside_bound=" << figures.first_outside_bound
+              << " first_inside_perimeter=" << figures.first_inside_perimeter
+              << " peak_ratio_max=" << figures.peak_ratio_max
+              << " peak_growth=" << figures.peak_growth;
+  out << string_line.str() << "\n";
   return 0;
 }
 
@@ -261,10 +301,11 @@ int runCfSim(const std::vector<std::string>& arguments, std::ostream& out, std::
   }
   try {
     const Scenario scenario = loadScenarioFile(options.scenario_path, options.overrides);
-    if (options.continuous_step > 0.0 && std::isfinite(scenario.controller.jerk_limit)) {
+    const std::string unsupported =
+        options.continuous_step > 0.0 ? sampledOnlyKey(scenario) : std::string();
+    if (!unsupported.empty()) {
       err << "cf_sim: --continuous runs the continuous-time law, which has no control period: "
-             "controller.jerk_limit is not supported there (remove it, or run without "
-             "--continuous)\n";
+          << unsupported << " is not supported there (remove it, or run without --continuous)\n";
       return 2;
     }
     if (!options.sweep_path.empty()) {

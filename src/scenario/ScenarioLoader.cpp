@@ -14,6 +14,7 @@
 #include "projection_collision_avoidance/ControllerDesign.hpp"
 #include "projection_collision_avoidance/ParameterError.hpp"
 
+#include "ControllerReader.hpp"
 #include "YamlParser.hpp"
 #include "YamlReader.hpp"
 
@@ -109,123 +110,6 @@ AgentModel readModel(detail::YamlReader& reader) {
   return result;
 }
 
-/// natural_frequency or damping: one value per axis (or one number for all), each positive.
-void requirePositivePerAxis(const std::string& key, const Eigen::VectorXd& values, int axes) {
-  if (values.size() != axes) {
-    throw ParameterError(key, "must be one number or one per axis (" + std::to_string(axes) +
-                                  "), got " + std::to_string(values.size()));
-  }
-  for (Eigen::Index i = 0; i < values.size(); ++i) {
-    if (!(std::isfinite(values(i)) && values(i) > 0.0)) {
-      throw ParameterError(key, "must be positive and finite, got " + std::to_string(values(i)));
-    }
-  }
-}
-
-Eigen::MatrixXd readGain(detail::YamlReader& section, const AgentModel& model) {
-  const bool matrix_form = section.has("gain");
-  const bool pole_form = section.has("natural_frequency") || section.has("damping");
-  if (matrix_form && pole_form) {
-    throw ParameterError(section.key("gain"),
-                         "give either gain or natural_frequency/damping, not both");
-  }
-  if (!pole_form) {
-    return section.matrix("gain", model.inputDimension(), model.outputDimension());
-  }
-  if (!model.isDoubleIntegrator() || !model.C.isIdentity(0.0)) {
-    throw ParameterError(section.key("natural_frequency"),
-                         "needs a double_integrator model with C = identity; give gain instead");
-  }
-  const int axes = model.double_integrator_axes;
-  const Eigen::VectorXd omega = section.vectorOrScalar("natural_frequency", axes);
-  const Eigen::VectorXd zeta = section.vectorOrScalar("damping", axes);
-  requirePositivePerAxis(section.key("natural_frequency"), omega, axes);
-  requirePositivePerAxis(section.key("damping"), zeta, axes);
-  return doubleIntegratorGain(omega, zeta, section.key("natural_frequency"));
-}
-
-ControllerParameters readController(detail::YamlReader& reader, const AgentModel& model) {
-  const Eigen::Index n = model.stateDimension();
-  const Eigen::Index m = model.inputDimension();
-  const Eigen::Index p = model.outputDimension();
-  detail::YamlReader controller = reader.map("controller");
-  ControllerParameters result;
-  result.model = model;
-  result.control_rate = controller.number("control_rate");
-  result.separation = controller.vector("separation");
-  result.alpha = controller.number("alpha");
-  result.epsilon = controller.number("epsilon");
-
-  detail::YamlReader baseline = controller.map("baseline");
-  result.baseline_gain = readGain(baseline, model);
-  baseline.finish();
-
-  detail::YamlReader estimator = controller.map("estimator");
-  result.estimator_gain = estimator.matrix("gain", n, p);
-  result.lyapunov_weight = estimator.matrix("lyapunov_weight", n, n);
-  if (estimator.has("substeps")) {
-    result.estimator_substeps = estimator.integer("substeps");
-  }
-  if (estimator.has("initial_estimate")) {
-    const std::string mode = estimator.string("initial_estimate");
-    if (mode == "measurement") {
-      result.initial_estimate = InitialEstimate::kMeasurement;
-    } else if (mode == "zero") {
-      result.initial_estimate = InitialEstimate::kZero;
-    } else {
-      throw ParameterError(estimator.key("initial_estimate"),
-                           "must be measurement or zero, got '" + mode + "'");
-    }
-  }
-  estimator.finish();
-
-  detail::YamlReader tracker = controller.map("tracker");
-  result.tracker_enabled = tracker.boolean("enabled");
-  result.tracker_gain = readGain(tracker, model);
-  result.reference_gain = tracker.has("reference_gain") ? tracker.matrix("reference_gain", m, p)
-                                                        : Eigen::MatrixXd::Zero(m, p);
-  tracker.finish();
-
-  if (controller.has("acceleration_limit")) {
-    result.acceleration_limit = controller.number("acceleration_limit");
-  }
-  if (controller.has("jerk_limit")) {
-    result.jerk_limit = controller.number("jerk_limit");
-  }
-  if (controller.has("fallback")) {
-    detail::YamlReader fallback = controller.map("fallback");
-    if (fallback.has("gain") && fallback.has("velocity_gain")) {
-      throw ParameterError(fallback.key("gain"), "give gain or velocity_gain, not both");
-    }
-    if (fallback.has("gain")) {
-      result.fallback_gain = fallback.matrix("gain", m, n);
-    } else if (fallback.has("velocity_gain")) {
-      if (!model.isDoubleIntegrator()) {
-        throw ParameterError(fallback.key("velocity_gain"),
-                             "needs a double_integrator model; give gain instead");
-      }
-      result.fallback_gain = doubleIntegratorFallbackGain(model.double_integrator_axes,
-                                                          fallback.number("velocity_gain"));
-    }
-    fallback.finish();
-  }
-  if (controller.has("leader_information")) {
-    detail::YamlReader sharing = controller.map("leader_information");
-    if (sharing.has("command")) {
-      result.leader_input_in_command = sharing.boolean("command");
-    }
-    if (sharing.has("estimator")) {
-      result.leader_input_in_estimator = sharing.boolean("estimator");
-    }
-    if (sharing.has("disturbance")) {
-      result.leader_disturbance_shared = sharing.boolean("disturbance");
-    }
-    sharing.finish();
-  }
-  controller.finish();
-  return result;
-}
-
 /// The pulses of the list @p name; each is checked against @p size entries, so that an error
 /// names the entry by its path in the file ("leader.disturbance.0.vector").
 std::vector<Pulse> readPulses(detail::YamlReader& parent, const std::string& name,
@@ -291,7 +175,7 @@ Scenario readScenario(const YAML::Node& root, const ScenarioLoadOptions& options
   detail::YamlReader reader(root, "");
   Scenario scenario;
   const AgentModel model = readModel(reader);
-  scenario.controller = readController(reader, model);
+  scenario.controller = detail::readController(reader, model, &scenario.link);
 
   detail::YamlReader leader = reader.map("leader");
   scenario.leader_initial_state = leader.vector("initial_state");

@@ -2,6 +2,8 @@
 /// keeps its estimate across a parameter change, and allocates nothing per step (see
 /// test_no_allocation for the counting).
 
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 #include "projection_collision_avoidance/RuntimeFollowerController.hpp"
@@ -30,6 +32,31 @@ TEST(RuntimeFollowerController, MatchesTheFixedSizeController) {
   }
   EXPECT_EQ(runtime.stateDimension(), 4);
   EXPECT_EQ(runtime.inputDimension(), 2);
+}
+
+TEST(RuntimeFollowerController, OwnStateAndSharedInputMatchTheFixedSizeController) {
+  // The platoon's configuration: time headway (S1), shaped feed-forward (S2).
+  const ControllerDesign design = ControllerDesign::create(
+      loadScenarioFile(testing::scenarioPath("platoon_run2.yaml")).controller);
+  ASSERT_GT(design.parameters.time_headway, 0.0);
+  RuntimeFollowerController runtime(design);
+  FollowerController<DoubleIntegrator1D> fixed(design);
+  for (int k = 0; k < 500; ++k) {
+    const Eigen::Vector2d y(0.02 * k - 3.0, std::sin(0.05 * k));
+    const Eigen::Vector2d own_state(0.1 * k, 2.0 * std::cos(0.03 * k));
+    const Eigen::Matrix<double, 1, 1> leader_input(std::sin(0.2 * k));
+    const bool shared = k % 3 != 0;
+    const auto& a = shared ? runtime.stepWithOwnState(y, own_state, leader_input)
+                           : runtime.stepWithOwnState(y, own_state);
+    const auto& b = shared ? fixed.stepWithOwnState(y, own_state, leader_input)
+                           : fixed.stepWithOwnState(y, own_state);
+    ASSERT_MATRIX_NEAR(a.command, b.command, 0.0);
+    ASSERT_MATRIX_NEAR(a.headway_command, b.headway_command, 0.0);
+    ASSERT_MATRIX_NEAR(a.feedforward_command, b.feedforward_command, 0.0);
+    ASSERT_MATRIX_NEAR(a.estimate, b.estimate, 0.0);
+    ASSERT_EQ(a.projection_active, b.projection_active);
+  }
+  EXPECT_GT(runtime.status().headway_command.norm(), 0.0);
 }
 
 TEST(RuntimeFollowerController, SetDesignKeepsTheEstimateInsideTheNewBound) {

@@ -1,6 +1,7 @@
 /// The follower's control cycle and its real-time hand-offs, without ROS: the control thread
-/// allocates and frees nothing over 10,000 ticks with every input and output in use; modes, time
-/// jumps and stalls; the lock-free slot, queue and doorbell.
+/// allocates and frees nothing over 10,000 ticks with every input (the own state of a time
+/// headway included) and output in use; modes, time jumps and stalls; the own state used only
+/// while fresh; the lock-free slot, queue and doorbell.
 
 #include <atomic>
 #include <chrono>
@@ -25,16 +26,19 @@ namespace {
 constexpr std::int64_t kMs = 1000000;  // ns
 constexpr std::int64_t kStart = 1000 * 1000 * kMs;
 
-ControllerDesign run2Design() {
+/// Run 2's controller at 1 kHz, with a time headway of @p time_headway s (S1).
+ControllerDesign run2Design(double time_headway = 0.0) {
   ControllerParameters p = testing::paperParameters();  // Run 2's controller
   p.control_rate = 1000.0;
   p.acceleration_limit = 6.0;
   p.jerk_limit = 500.0;
+  p.time_headway = time_headway;
   return ControllerDesign::create(p);
 }
 
-std::unique_ptr<FollowerCycle> makeCycle(FollowerCycleSettings settings = {}) {
-  const ControllerDesign design = run2Design();
+std::unique_ptr<FollowerCycle> makeCycle(FollowerCycleSettings settings = {},
+                                         double time_headway = 0.0) {
+  const ControllerDesign design = run2Design(time_headway);
   return std::make_unique<FollowerCycle>(std::make_unique<RuntimeFollowerController>(design),
                                          design.parameters.separation, settings);
 }
@@ -49,16 +53,27 @@ MeasurementSample measurementAt(std::int64_t stamp_ns, std::uint64_t sequence, d
   return m;
 }
 
+OwnStateSample ownStateAt(std::int64_t stamp_ns, std::uint64_t sequence, double velocity) {
+  OwnStateSample own;
+  own.stamp_ns = stamp_ns;
+  own.receipt_ns = stamp_ns;
+  own.sequence = sequence;
+  own.state.setZero(2);
+  own.state << 0.001 * static_cast<double>(sequence), velocity;
+  return own;
+}
+
 TEST(FollowerCycle, TheControlThreadAllocatesAndFreesNothing) {
   FollowerCycleSettings settings;
   settings.use_leader_input = true;
-  std::unique_ptr<FollowerCycle> cycle = makeCycle(settings);
+  std::unique_ptr<FollowerCycle> cycle = makeCycle(settings, 0.5);
   Handoff<FollowerCycleOutput, 64> outputs;
   constexpr int kTicks = 12000;
   std::atomic<std::int64_t> clock{kStart};
   std::atomic<bool> done{false};
 
-  // The subscriber's side: measurements (with a 1 s outage from tick 4000) and leader broadcasts.
+  // The subscriber's side: measurements (with a 1 s outage from tick 4000), leader broadcasts and
+  // the own odometry.
   std::thread inputs([&] {
     std::uint64_t sequence = 0;
     std::int64_t last = 0;
@@ -72,6 +87,7 @@ TEST(FollowerCycle, TheControlThreadAllocatesAndFreesNothing) {
         leader.stamp_ns = leader.receipt_ns = now;
         leader.acceleration.setConstant(1, -0.5);
         cycle->leader().write(leader);
+        cycle->ownState().write(ownStateAt(now, sequence, 1.0 + 0.1 * std::cos(1e-9 * now)));
         last = now;
       }
       std::this_thread::yield();
@@ -80,6 +96,7 @@ TEST(FollowerCycle, TheControlThreadAllocatesAndFreesNothing) {
   // The publisher's side: takes every output (and would build messages from it).
   long published = 0;
   long steps_seen = 0;
+  long headway_steps = 0;
   std::thread publisher([&] {
     FollowerCycleOutput out;
     std::uint32_t seen = outputs.count();
@@ -87,6 +104,7 @@ TEST(FollowerCycle, TheControlThreadAllocatesAndFreesNothing) {
       while (outputs.pop(&out)) {
         ++published;
         steps_seen += out.stepped ? 1 : 0;
+        headway_steps += out.stepped && out.own_state_fresh ? 1 : 0;
       }
       seen = outputs.wait(seen, 10 * kMs);
     }
@@ -96,7 +114,7 @@ TEST(FollowerCycle, TheControlThreadAllocatesAndFreesNothing) {
   long allocations = -1;
   long frees = -1;
   std::unique_ptr<RuntimeFollowerController> offered =
-      std::make_unique<RuntimeFollowerController>(run2Design());
+      std::make_unique<RuntimeFollowerController>(run2Design(0.5));
   std::thread control([&] {
     FollowerCycleOutput out;
     const long allocations_before = testing::threadAllocationCount();
@@ -124,6 +142,7 @@ TEST(FollowerCycle, TheControlThreadAllocatesAndFreesNothing) {
   EXPECT_NE(cycle->retired(), nullptr);  // the reconfiguration was adopted
   EXPECT_GE(published + static_cast<long>(outputs.dropped()), kTicks);
   EXPECT_GE(steps_seen, 10000);
+  EXPECT_GE(headway_steps, 9000);  // the time headway stepped with the own state
 }
 
 TEST(FollowerCycle, ModesFromTheInputsAges) {
@@ -140,6 +159,44 @@ TEST(FollowerCycle, ModesFromTheInputsAges) {
   ASSERT_TRUE(cycle->tick(kStart + 600 * kMs, 0.0, 0, &out));
   EXPECT_EQ(out.mode, FollowerMode::kMeasurementLost);
   EXPECT_TRUE(out.status.fallback);
+}
+
+TEST(FollowerCycle, ATimeHeadwayStepsWithTheOwnStateWhileItIsFresh) {
+  std::unique_ptr<FollowerCycle> cycle = makeCycle({}, 0.5);
+  FollowerCycleOutput out;
+  cycle->measurement().write(measurementAt(kStart, 1, 5.0));
+  ASSERT_TRUE(cycle->tick(kStart + kMs, 0.0, 0, &out));  // no odometry yet: no headway
+  EXPECT_FALSE(out.own_state_fresh);
+  EXPECT_EQ(out.status.headway_command.norm(), 0.0);
+  EXPECT_EQ(out.time_headway, 0.5);
+  cycle->ownState().write(ownStateAt(kStart + kMs, 1, 2.0));
+  cycle->measurement().write(measurementAt(kStart + 2 * kMs, 2, 5.0));
+  ASSERT_TRUE(cycle->tick(kStart + 2 * kMs, 0.0, 0, &out));
+  EXPECT_TRUE(out.own_state_fresh);
+  EXPECT_GT(out.status.headway_command.norm(), 0.0);
+  // The odometry older than the measurement timeout (0.5 s): the headway is left out.
+  cycle->measurement().write(measurementAt(kStart + 600 * kMs, 3, 5.0));
+  ASSERT_TRUE(cycle->tick(kStart + 600 * kMs, 0.0, 0, &out));
+  EXPECT_EQ(out.mode, FollowerMode::kTracking);
+  EXPECT_FALSE(out.own_state_fresh);
+  EXPECT_EQ(out.status.headway_command.norm(), 0.0);
+  // Of an old timeline after ROS time went back: not used either.
+  cycle->ownState().write(ownStateAt(kStart + 601 * kMs, 2, 2.0));
+  cycle->measurement().write(measurementAt(kStart - 1000 * kMs, 4, 5.0));
+  ASSERT_TRUE(cycle->tick(kStart - 999 * kMs, 0.0, 0, &out));
+  EXPECT_EQ(out.mode, FollowerMode::kTracking);
+  EXPECT_FALSE(out.own_state_fresh);
+}
+
+TEST(FollowerCycle, WithoutATimeHeadwayTheOwnStateIsNotUsed) {
+  std::unique_ptr<FollowerCycle> cycle = makeCycle();
+  FollowerCycleOutput out;
+  cycle->ownState().write(ownStateAt(kStart, 1, 2.0));
+  cycle->measurement().write(measurementAt(kStart, 1, 5.0));
+  ASSERT_TRUE(cycle->tick(kStart + kMs, 0.0, 0, &out));
+  EXPECT_FALSE(out.own_state_fresh);
+  EXPECT_EQ(out.status.headway_command.norm(), 0.0);
+  EXPECT_EQ(out.time_headway, 0.0);
 }
 
 TEST(FollowerCycle, AJumpBackOfTimeInvalidatesTheOldTimelinesInputs) {

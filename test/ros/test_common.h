@@ -34,6 +34,9 @@ struct StatusRecord {
   int fallback_ticks = 0;       ///< statuses with fallback set
   std::set<int> modes;          ///< FollowerStatus::mode values seen
   double last_time = 0.0;       ///< stamp of the latest status (s)
+  int leader_age_count = 0;     ///< statuses with a finite leader_age
+  double leader_age_sum = 0.0;  ///< s, their sum
+  double max_leader_age = 0.0;  ///< s
   FollowerStatus last;
 };
 
@@ -52,6 +55,11 @@ inline void addStatus(const FollowerStatus& msg, StatusRecord* record) {
   record->fallback_ticks += msg.fallback ? 1 : 0;
   record->modes.insert(msg.mode);
   record->last_time = msg.header.stamp.toSec();
+  if (std::isfinite(msg.leader_age)) {
+    ++record->leader_age_count;
+    record->leader_age_sum += msg.leader_age;
+    record->max_leader_age = std::max(record->max_leader_age, msg.leader_age);
+  }
   record->last = msg;
 }
 

@@ -32,6 +32,14 @@ struct LeaderSample {
   GenericDimensions::InputVector acceleration;  ///< a_target (m/s^2)
 };
 
+/// One accepted odometry of the follower itself: its own state, from which a time headway acts.
+struct OwnStateSample {
+  std::int64_t stamp_ns = 0;
+  std::int64_t receipt_ns = 0;
+  std::uint64_t sequence = 0;
+  GenericDimensions::StateVector state;  ///< x_i (m, m/s)
+};
+
 /// What the follower's control cycle needs besides the controller's design.
 struct FollowerCycleSettings {
   double measurement_timeout = 0.5;  ///< s: an older measurement is stale
@@ -50,8 +58,11 @@ struct FollowerCycleOutput {
   std::uint64_t steps = 0;    ///< control steps run since start, this one included
   FollowerMode mode = FollowerMode::kWaiting;
   bool leader_fresh = false;
-  double measurement_age = 0.0;       ///< s at the stamp; +inf when none on this timeline
-  double leader_age = 0.0;            ///< s at the stamp; +inf when none on this timeline
+  double measurement_age = 0.0;  ///< s at the stamp; +inf when none on this timeline
+  double leader_age = 0.0;       ///< s at the stamp; +inf when none on this timeline
+  /// The step used the own state: a time headway is in force and the own odometry was younger
+  /// than the measurement timeout at the stamp (else the headway is left out this step).
+  bool own_state_fresh = false;
   GenericDimensions::StateVector xi;  ///< x_target - x_i - d of the measurement used (m, m/s)
   double distance = 0.0;              ///< ||p_target - p_i|| of that measurement (m)
   RuntimeFollowerStatus status;       ///< the controller's step
@@ -62,6 +73,7 @@ struct FollowerCycleOutput {
   double acceleration_limit = 0.0;  ///< in force (m/s^2)
   double jerk_limit = 0.0;          ///< in force (m/s^3)
   bool tracker_enabled = false;     ///< in force
+  double time_headway = 0.0;        ///< h in force (s); 0: constant spacing
   std::uint32_t missed_periods = 0;
   std::uint32_t late_periods = 0;
   double tick_delay = 0.0;       ///< s, of the latest step
@@ -71,8 +83,11 @@ struct FollowerCycleOutput {
 };
 
 /// The follower's control cycle without ROS: it reads the latest accepted inputs from lock-free
-/// slots the input side writes (measurement(), leader()), decides the mode from their ages,
-/// runs one step of the controller and fills a FollowerCycleOutput. Nothing in tick() or
+/// slots the input side writes (measurement(), leader(), ownState()), decides the mode from their
+/// ages, runs one step of the controller and fills a FollowerCycleOutput. With a time headway
+/// (time_headway > 0) a step with a measurement uses the own state while it is younger than the
+/// measurement timeout (RuntimeFollowerController::stepWithOwnState()), else leaves the headway
+/// out. Nothing in tick() or
 /// stepOnMeasurement() allocates, locks (except under the measurement trigger, whose steps
 /// run in the measurement's callback, and a tick waits for a step running there) or makes a
 /// system call, so that a real-time thread can run it.
@@ -96,6 +111,8 @@ class FollowerCycle {
   LatestValue<MeasurementSample>& measurement() { return measurement_; }
   /// The slot the leader-broadcast callback writes (one writer thread).
   LatestValue<LeaderSample>& leader() { return leader_; }
+  /// The slot the own odometry's callback writes (one writer thread; time headway only).
+  LatestValue<OwnStateSample>& ownState() { return own_state_; }
 
   /// A tick of the fixed-rate loop at ROS time @p now_ns, @p delay s after it was due, with
   /// @p skipped periods skipped before it. Timer trigger: a step stamped now. Measurement
@@ -137,10 +154,13 @@ class FollowerCycle {
 
   LatestValue<MeasurementSample> measurement_;
   LatestValue<LeaderSample> leader_;
+  LatestValue<OwnStateSample> own_state_;
   bool have_measurement_ = false;  ///< a measurement valid on this timeline
   bool ever_measured_ = false;     ///< a measurement was accepted since start
   bool have_leader_ = false;
   bool ever_led_ = false;
+  bool have_own_state_ = false;
+  bool ever_own_state_ = false;
 
   bool have_latest_time_ = false;
   std::int64_t latest_time_ns_ = 0;  ///< latest ROS time seen (jumps back)

@@ -19,7 +19,9 @@ struct Scenario;
 /// keeps the separation d_i of its slot to its target (the leader, or the follower ahead of it in
 /// a chain). Subscribes `relative_measurement` (RelativeMeasurement, x_target - x_i) and
 /// `leader_broadcast` (LeaderBroadcast of the target: monitored always, its acceleration u_1, plus
-/// pinv(B) u_d with controller.leader_information.disturbance, used with ~use_leader_broadcast).
+/// pinv(B) u_d with controller.leader_information.disturbance, used with ~use_leader_broadcast)
+/// and, with a time headway (controller.spacing.time_headway > 0), `odom` (nav_msgs/Odometry:
+/// its own state x_i, from which the headway term K_h x_i of (S1) acts).
 /// At each control step (see ~trigger below) it picks the mode from the inputs' ages
 /// (selectFollowerMode()): with a fresh measurement it runs the controller on
 /// y = C (x_target - x_i - d_i), with a stale one the braking fallback; then it publishes

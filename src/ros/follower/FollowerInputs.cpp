@@ -21,10 +21,14 @@ FollowerInputs::FollowerInputs(std::string node_name, const FollowerNodeOptions&
           "relative_measurement",
           {options.measurement_frame, options.max_future_stamp, options.measurement_timeout}),
       leader_guard_("leader_broadcast", {options.leader_broadcast_frame, options.max_future_stamp,
-                                         options.leader_timeout}) {
+                                         options.leader_timeout}),
+      odometry_guard_("odom",
+                      {options.odom_frame, options.max_future_stamp, options.measurement_timeout}) {
   measurement_.relative_state.setZero(2 * axes_);
   leader_.acceleration.setZero(axes_);
+  own_state_.state.setZero(2 * axes_);
   relative_state_ = Eigen::VectorXd::Zero(2 * axes_);
+  odometry_state_ = Eigen::VectorXd::Zero(2 * axes_);
 }
 
 void FollowerInputs::start(ros::NodeHandle nh) {
@@ -32,6 +36,10 @@ void FollowerInputs::start(ros::NodeHandle nh) {
                                          this, ros::TransportHints().tcpNoDelay());
   leader_subscriber_ =
       nh.subscribe("leader_broadcast", 10, &FollowerInputs::onLeaderBroadcast, this);
+  if (design_.parameters.time_headway > 0.0) {
+    odometry_subscriber_ = nh.subscribe("odom", 10, &FollowerInputs::onOdometry, this,
+                                        ros::TransportHints().tcpNoDelay());
+  }
 }
 
 void FollowerInputs::Heard::note(std::int64_t stamp_ns, std::int64_t now_ns) {
@@ -53,6 +61,7 @@ FollowerInputStats FollowerInputs::stats(std::int64_t now_ns) const {
   stats.leader_age = leader_heard_.ageAt(now_ns);
   stats.rejected_measurements = rejected_measurements_.load(std::memory_order_relaxed);
   stats.rejected_leader_broadcasts = rejected_leader_broadcasts_.load(std::memory_order_relaxed);
+  stats.rejected_odometry = rejected_odometry_.load(std::memory_order_relaxed);
   const std::lock_guard<std::mutex> lock(reasons_mutex_);
   stats.measurement_rejection = measurement_rejection_;
   stats.leader_rejection = leader_rejection_;
@@ -133,6 +142,30 @@ void FollowerInputs::onLeaderBroadcast(const LeaderBroadcast::ConstPtr& msg) {
     const std::lock_guard<std::mutex> lock(reasons_mutex_);
     leader_rejection_ = leader_guard_.lastRejection();
   }
+}
+
+void FollowerInputs::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
+  admitGuarded(odometry_guard_, name_, [&] {
+    const ros::Time now = ros::Time::now();
+    if (odometry_clock_.wentBack(now)) {
+      odometry_guard_.restartTimeline();
+    }
+    if (!checkHeader(odometry_guard_, msg->header, now)) {
+      return;
+    }
+    if (!stateFromOdometryMsg(*msg, axes_, &odometry_state_)) {
+      odometry_guard_.reject(Rejection::kContent, "non-finite position or velocity");
+      return;
+    }
+    const std::int64_t stamp = nanosecondsOf(msg->header.stamp);
+    odometry_guard_.accept(stamp, nanosecondsOf(now));
+    own_state_.stamp_ns = stamp;
+    own_state_.receipt_ns = nanosecondsOf(now);
+    own_state_.sequence = odometry_guard_.accepted();
+    own_state_.state = odometry_state_;
+    cycle_->ownState().write(own_state_);
+  });
+  rejected_odometry_.store(odometry_guard_.rejected(), std::memory_order_relaxed);
 }
 
 }  // namespace projection_collision_avoidance

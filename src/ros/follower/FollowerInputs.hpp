@@ -6,6 +6,7 @@
 #include <mutex>
 #include <string>
 
+#include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
 
 #include "projection_collision_avoidance/ControllerDesign.hpp"
@@ -24,6 +25,7 @@ namespace projection_collision_avoidance {
 struct FollowerInputStats {
   std::uint64_t rejected_measurements = 0;
   std::uint64_t rejected_leader_broadcasts = 0;
+  std::uint64_t rejected_odometry = 0;
   std::string measurement_rejection;  ///< the latest, "" once one was accepted after it
   std::string leader_rejection;
   double measurement_age =
@@ -31,9 +33,11 @@ struct FollowerInputStats {
   double leader_age = -1.0;  ///< s, of the last accepted leader broadcast; -1: none
 };
 
-/// The follower's inputs: subscribes `relative_measurement` and `leader_broadcast`, judges each
-/// message with its InputGuard (doc/boundary.md) on the subscriber's thread, and writes what it
-/// accepts into the control cycle's lock-free slots. With ~trigger measurement, each accepted
+/// The follower's inputs: subscribes `relative_measurement`, `leader_broadcast` and, with a time
+/// headway (time_headway > 0), `odom` (nav_msgs/Odometry: its own state; frame ~odom_frame,
+/// refused once older than ~measurement_timeout on arrival), judges each message with its
+/// InputGuard (doc/boundary.md) on the subscriber's thread, and writes what it accepts into the
+/// control cycle's lock-free slots. With ~trigger measurement, each accepted
 /// measurement runs the cycle's step at once and hands its output to @p on_step. Nothing a
 /// message carries can end the node (admitGuarded()). The subscriptions start with start().
 class FollowerInputs {
@@ -48,6 +52,8 @@ class FollowerInputs {
 
   /// Subscribes the inputs (once what the callbacks use is in place).
   void start(ros::NodeHandle nh);
+  /// The own odometry's topic ("" without a time headway), once started.
+  std::string odometryTopic() const { return odometry_subscriber_.getTopic(); }
 
   /// Refusal counts, latest reasons and the inputs' ages at ROS time @p now_ns (any thread).
   FollowerInputStats stats(std::int64_t now_ns) const;
@@ -55,6 +61,7 @@ class FollowerInputs {
  private:
   void onMeasurement(const RelativeMeasurement::ConstPtr& msg);
   void onLeaderBroadcast(const LeaderBroadcast::ConstPtr& msg);
+  void onOdometry(const nav_msgs::Odometry::ConstPtr& msg);
   /// One input's last accepted message, for its age: effective stamp min(stamp, receipt) and
   /// receipt (ns); kNone when there is none on this timeline.
   struct Heard {
@@ -87,10 +94,15 @@ class FollowerInputs {
   InputGuard leader_guard_;
   ClockWatch leader_clock_;
   LeaderSample leader_;
+  InputGuard odometry_guard_;
+  ClockWatch odometry_clock_;
+  OwnStateSample own_state_;
+  Eigen::VectorXd odometry_state_;
 
   // Read by other threads.
   std::atomic<std::uint64_t> rejected_measurements_{0};
   std::atomic<std::uint64_t> rejected_leader_broadcasts_{0};
+  std::atomic<std::uint64_t> rejected_odometry_{0};
   Heard measurement_heard_;
   Heard leader_heard_;
   mutable std::mutex reasons_mutex_;
@@ -99,6 +111,7 @@ class FollowerInputs {
 
   ros::Subscriber measurement_subscriber_;
   ros::Subscriber leader_subscriber_;
+  ros::Subscriber odometry_subscriber_;  ///< only with a time headway (S1)
 };
 
 }  // namespace projection_collision_avoidance

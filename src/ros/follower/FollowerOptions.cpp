@@ -62,6 +62,7 @@ FollowerNodeOptions readFollowerOptions(NodeOptionReader& reader, const Controll
   options.use_leader_broadcast = reader.boolean("use_leader_broadcast", false);
   options.measurement_frame = reader.text("measurement_frame", "");
   options.leader_broadcast_frame = reader.text("leader_broadcast_frame", "");
+  options.odom_frame = reader.text("odom_frame", "");
   options.follower_frame = reader.text("follower_frame", member.name);
   if (options.follower_frame.empty()) {
     throw ParameterError("~follower_frame", "must not be empty");

@@ -39,6 +39,7 @@ struct FollowerNodeOptions {
   bool use_leader_broadcast = false;   ///< use u_1 from leader_broadcast (always monitored)
   std::string measurement_frame;       ///< required frame_id of measurements ("" = any)
   std::string leader_broadcast_frame;  ///< required frame_id of leader broadcasts ("" = any)
+  std::string odom_frame;              ///< required frame_id of the own odometry ("" = any)
   std::string follower_frame;  ///< frame of the command, status and markers (default: the name)
   double marker_rate = 10.0;   ///< Hz
   int formation_index = 1;     ///< i: which follower of the scenario's formation this is

@@ -56,6 +56,7 @@ void FollowerOutputs::remember(const FollowerCycleOutput& out) {
   latest_.acceleration_limit = out.acceleration_limit;
   latest_.jerk_limit = out.jerk_limit;
   latest_.tracker_enabled = out.tracker_enabled;
+  latest_.time_headway = out.time_headway;
   latest_.missed_periods = out.missed_periods;
   latest_.late_periods = out.late_periods;
   latest_.tick_delay = out.tick_delay;
@@ -213,6 +214,9 @@ void FollowerOutputs::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat
   }
   status.add("rejected_measurements", inputs.rejected_measurements);
   status.add("rejected_leader_broadcasts", inputs.rejected_leader_broadcasts);
+  status.add("time_headway (s)", s.time_headway);
+  status.add("own_state_fresh", s.own_state_fresh);
+  status.add("rejected_odometry", inputs.rejected_odometry);
   status.add("measurement_age (s)", inputs.measurement_age);
   status.add("leader_age (s)", inputs.leader_age);
   status.add("time_jumps", s.time_jumps);

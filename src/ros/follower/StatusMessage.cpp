@@ -21,6 +21,7 @@ FollowerStatus toStatusMsg(const FollowerCycleOutput& out, const FollowerInputSt
   msg.measurement_age = out.measurement_age;
   msg.rejected_measurements = static_cast<uint32_t>(inputs.rejected_measurements);
   msg.leader_fresh = out.leader_fresh;
+  msg.leader_age = out.leader_age;  // +inf when none on this timeline
   msg.rejected_leader_broadcasts = static_cast<uint32_t>(inputs.rejected_leader_broadcasts);
   msg.xi = toStdVector(out.xi);
   msg.xi_hat = toStdVector(s.estimate);
@@ -40,6 +41,8 @@ FollowerStatus toStatusMsg(const FollowerCycleOutput& out, const FollowerInputSt
   msg.baseline_command = toStdVector(s.baseline_command);
   msg.tracker_command = toStdVector(s.tracker_command);
   msg.feedforward_command = toStdVector(s.feedforward_command);
+  msg.headway_command = toStdVector(s.headway_command);
+  msg.own_state_fresh = out.own_state_fresh;
   msg.fallback_command = toStdVector(s.fallback_command);
   msg.separation = out.distance;
   msg.perimeter = out.perimeter;

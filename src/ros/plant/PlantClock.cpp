@@ -16,13 +16,8 @@ constexpr double kMaxCatchUp = 0.05;
 }  // namespace
 
 PlantClock::PlantClock(ros::NodeHandle nh, std::string node_name, const PlantNodeOptions& options,
-                       std::mutex* mutex, Tick tick, Stop stop, Jump jump)
-    : name_(std::move(node_name)),
-      options_(options),
-      mutex_(mutex),
-      tick_(std::move(tick)),
-      stop_(std::move(stop)),
-      jump_(std::move(jump)) {
+                       std::mutex* mutex, Hooks hooks)
+    : name_(std::move(node_name)), options_(options), mutex_(mutex), hooks_(std::move(hooks)) {
   if (options_.duration > 0.0) {
     last_tick_ = std::lround(options_.duration * options_.rate);
   }
@@ -33,6 +28,7 @@ PlantClock::PlantClock(ros::NodeHandle nh, std::string node_name, const PlantNod
     origin_ = ros::Time(0);
     wall_origin_ = ros::WallTime::now();
     rate_check_wall_ = wall_origin_;
+    waiting_for_followers_ = options_.wait_for_followers > 0.0;
     wall_timer_ =
         nh.createWallTimer(ros::WallDuration(1.0 / (options_.rate * options_.real_time_factor)),
                            &PlantClock::onWallTick, this);
@@ -58,11 +54,63 @@ void PlantClock::halt() {
   timer_.stop();
 }
 
-void PlantClock::runThrough(long due) {
+void PlantClock::runThrough(long due, const ros::WallTime& wall_now) {
   while (running_ && next_tick_ <= due) {
-    running_ = tick_(next_tick_);
+    if (options_.lockstep && holdForCommands(wall_now)) {
+      break;
+    }
+    running_ = hooks_.tick(next_tick_);
     ++next_tick_;
   }
+}
+
+bool PlantClock::waitingForFollowers(const ros::WallTime& now) {
+  if (!waiting_for_followers_) {
+    return false;
+  }
+  // Simulated time starts once every follower listens, or ~wait_for_followers s after start.
+  const std::pair<int, int> listening = hooks_.listening();
+  const double waited = (now - wall_origin_).toSec();
+  const bool all = listening.first == listening.second;
+  if (!all && waited < options_.wait_for_followers) {
+    return true;
+  }
+  waiting_for_followers_ = false;
+  if (all) {
+    ROS_INFO_STREAM(name_ << ": every follower listens after " << waited
+                          << " s: simulated time starts");
+  } else {
+    ROS_WARN_STREAM(name_ << ": " << listening.first << " of " << listening.second
+                          << " followers listen after ~wait_for_followers = " << waited
+                          << " s: simulated time starts without the others");
+  }
+  wall_origin_ = now;
+  rate_check_wall_ = now;
+  return false;
+}
+
+bool PlantClock::holdForCommands(const ros::WallTime& now) {
+  if (next_tick_ == 0 || hooks_.answered(next_tick_ - 1)) {
+    holding_ = false;
+    return false;
+  }
+  if (!holding_) {
+    holding_ = true;
+    hold_start_ = now;
+  }
+  if ((now - hold_start_).toSec() < options_.lockstep_timeout) {
+    // Simulated time waits: the wall schedule restarts from here.
+    const double wall_rate = options_.rate * options_.real_time_factor;
+    wall_origin_ = now - ros::WallDuration(static_cast<double>(next_tick_) / wall_rate);
+    return true;
+  }
+  holding_ = false;
+  ++lockstep_timeouts_;
+  ROS_WARN_STREAM_THROTTLE(5.0, name_ << ": lockstep: tick " << next_tick_ << " waited "
+                                      << options_.lockstep_timeout
+                                      << " s for the commands and runs without them ("
+                                      << lockstep_timeouts_ << " such ticks)");
+  return false;
 }
 
 void PlantClock::onWallTick(const ros::WallTimerEvent& /*event*/) {
@@ -76,6 +124,9 @@ void PlantClock::onWallTick(const ros::WallTimerEvent& /*event*/) {
   // (simulated time slows down) and reported below.
   const double wall_rate = options_.rate * options_.real_time_factor;
   const ros::WallTime now = ros::WallTime::now();
+  if (waitingForFollowers(now)) {
+    return;
+  }
   long due =
       static_cast<long>(std::floor((now - wall_origin_).toSec() * wall_rate + kTickTolerance));
   const long max_catch_up = std::max(1L, std::lround(kMaxCatchUp * wall_rate));
@@ -83,7 +134,7 @@ void PlantClock::onWallTick(const ros::WallTimerEvent& /*event*/) {
     due = next_tick_;
     wall_origin_ = now - ros::WallDuration(static_cast<double>(next_tick_) / wall_rate);
   }
-  runThrough(due);
+  runThrough(due, now);
   // Report, at most every 5 s, a simulation slower than the real-time factor asked for.
   const double wall = (now - rate_check_wall_).toSec();
   if (wall >= 5.0) {
@@ -115,7 +166,7 @@ void PlantClock::rosTick() {
     ROS_WARN_STREAM(name_ << ": ROS time went back by " << -clock_.jump() << " s, to "
                           << now.toSec() << " s; waiting for it to reach "
                           << stampOf(next_tick_).toSec() << " s again");
-    jump_(clock_.jump());
+    hooks_.jump(clock_.jump());
   }
   if (!started_) {
     // Under use_sim_time scenario time is ROS time; otherwise it starts at the first tick.
@@ -127,7 +178,7 @@ void PlantClock::rosTick() {
       std::ostringstream why;
       why << "ROS time " << now.toSec() << " s is already past ~duration = " << options_.duration
           << " s";
-      stop_(why.str());
+      hooks_.stop(why.str());
       return;
     }
   }
@@ -137,7 +188,8 @@ void PlantClock::rosTick() {
     return;  // ROS time went back: wait for it to reach the next tick again
   }
   // Catch up every due tick, at most one second of them per call.
-  runThrough(std::min(due, next_tick_ + std::max(1L, std::lround(options_.rate))));
+  runThrough(std::min(due, next_tick_ + std::max(1L, std::lround(options_.rate))),
+             ros::WallTime::now());
 }
 
 }  // namespace projection_collision_avoidance

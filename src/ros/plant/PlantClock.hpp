@@ -1,8 +1,10 @@
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <mutex>
 #include <string>
+#include <utility>
 
 #include <ros/ros.h>
 
@@ -21,18 +23,32 @@ namespace projection_collision_avoidance {
 /// up every tick that is due (at most one second of them per callback); scenario time is ROS
 /// time under use_sim_time and the time since the first tick otherwise; when ROS time goes back
 /// it waits for it to reach the next tick again.
+///
+/// Holding simulated time (publish_clock only): with ~wait_for_followers it stays at its start
+/// until every follower listens (or that many wall s have passed), and the wall schedule starts
+/// then; with ~lockstep tick k + 1 waits until the commands answering tick k are in (at most
+/// ~lockstep_timeout wall s, then it runs without them, counted and reported), the wall schedule
+/// restarting from the wait's end.
 class PlantClock {
  public:
-  /// Runs tick k; false to stop (the duration is reached).
-  using Tick = std::function<bool(long k)>;
-  /// Stops the plant for the reason given.
-  using Stop = std::function<void(const std::string& why)>;
-  /// ROS time went back by the amount given (s, negative).
-  using Jump = std::function<void(double jump)>;
+  /// What the clock asks of the plant and tells it.
+  struct Hooks {
+    /// Runs tick k; false to stop (the duration is reached).
+    std::function<bool(long k)> tick;
+    /// Stops the plant for the reason given.
+    std::function<void(const std::string& why)> stop;
+    /// ROS time went back by the amount given (s, negative).
+    std::function<void(double jump)> jump;
+    /// ~wait_for_followers: the followers listening to their measurements, and how many there
+    /// are.
+    std::function<std::pair<int, int>()> listening;
+    /// ~lockstep: whether every agent that has commanded answered tick k.
+    std::function<bool(long k)> answered;
+  };
 
   /// Starts the timers. Every callback runs under @p mutex.
   PlantClock(ros::NodeHandle nh, std::string node_name, const PlantNodeOptions& options,
-             std::mutex* mutex, Tick tick, Stop stop, Jump jump);
+             std::mutex* mutex, Hooks hooks);
 
   /// The stamp of tick k: origin + k / rate.
   ros::Time stampOf(long k) const;
@@ -45,22 +61,29 @@ class PlantClock {
   void onWallTick(const ros::WallTimerEvent& event);
   void onRosTick(const ros::TimerEvent& event);
   void rosTick();
-  /// Runs the ticks from next_tick_ through @p due while the plant runs.
-  void runThrough(long due);
+  /// Runs the ticks from next_tick_ through @p due while the plant runs (and, in lockstep, the
+  /// commands answer), at wall time @p wall_now.
+  void runThrough(long due, const ros::WallTime& wall_now);
+  /// ~wait_for_followers at wall time @p now: whether simulated time still stays at its start.
+  bool waitingForFollowers(const ros::WallTime& now);
+  /// ~lockstep: whether tick next_tick_ waits for the commands at wall time @p now.
+  bool holdForCommands(const ros::WallTime& now);
 
   std::string name_;
   PlantNodeOptions options_;
   std::mutex* mutex_;
-  Tick tick_;
-  Stop stop_;
-  Jump jump_;
+  Hooks hooks_;
   ClockWatch clock_;
   long next_tick_ = 0;
   long last_tick_ = -1;  ///< tick at the duration; -1 = run forever
   bool started_ = false;
   bool running_ = true;
-  ros::Time origin_;           ///< ROS time of scenario time 0
-  ros::WallTime wall_origin_;  ///< wall time of tick 0 (publish_clock)
+  ros::Time origin_;                    ///< ROS time of scenario time 0
+  ros::WallTime wall_origin_;           ///< wall time of tick 0 (publish_clock)
+  bool waiting_for_followers_ = false;  ///< holding simulated time (~wait_for_followers)
+  bool holding_ = false;                ///< lockstep: a tick waits for commands since hold_start_
+  ros::WallTime hold_start_;
+  std::uint64_t lockstep_timeouts_ = 0;  ///< ticks that ran without every command
   ros::WallTime rate_check_wall_;
   long rate_check_tick_ = 0;
   ros::WallTimer wall_timer_;

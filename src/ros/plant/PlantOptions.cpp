@@ -56,6 +56,14 @@ PlantNodeOptions readPlantOptions(NodeOptionReader& reader, const Scenario& scen
                          "must lie in (0, 1000], got " + std::to_string(o.real_time_factor));
   }
   o.duration = reader.number("duration", 0.0, 0.0, 1e7);
+  o.wait_for_followers = reader.number("wait_for_followers", 0.0, 0.0, 3600.0);
+  o.lockstep = reader.boolean("lockstep", false);
+  o.lockstep_timeout = reader.number("lockstep_timeout", o.lockstep_timeout, 0.001, 3600.0);
+  if (o.lockstep && !o.publish_clock) {
+    throw ParameterError("~lockstep",
+                         "is true but ~publish_clock is false: only a plant that drives "
+                         "simulated time can wait for the commands");
+  }
   return o;
 }
 

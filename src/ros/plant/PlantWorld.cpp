@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <sstream>
 #include <utility>
@@ -113,16 +114,25 @@ PlantWorld::PlantWorld(ros::NodeHandle nh, ros::NodeHandle private_nh)
   }
   // The clock's timers run their callbacks under mutex_: none before clock_ is set.
   const std::lock_guard<std::mutex> lock(mutex_);
-  clock_ = std::make_unique<PlantClock>(
-      nh_, name_, options_, &mutex_, [this](long k) { return tick(k); },
-      [this](const std::string& why) { stop(why); },
-      [this](double /*jump*/) {
-        // A restarted /clock: commands of the new timeline are judged afresh.
-        leader_.command_guard.restartTimeline();
-        for (Follower& follower : followers_) {
-          follower.agent.command_guard.restartTimeline();
-        }
-      });
+  PlantClock::Hooks hooks;
+  hooks.tick = [this](long k) { return tick(k); };
+  hooks.stop = [this](const std::string& why) { stop(why); };
+  hooks.jump = [this](double /*jump*/) {
+    // A restarted /clock: commands of the new timeline are judged afresh.
+    leader_.command_guard.restartTimeline();
+    for (Follower& follower : followers_) {
+      follower.agent.command_guard.restartTimeline();
+    }
+  };
+  hooks.listening = [this] {
+    int listening = 0;
+    for (const Follower& follower : followers_) {
+      listening += follower.measurement_publisher.getNumSubscribers() > 0 ? 1 : 0;
+    }
+    return std::make_pair(listening, static_cast<int>(followers_.size()));
+  };
+  hooks.answered = [this](long k) { return commandsAnswer(k); };
+  clock_ = std::make_unique<PlantClock>(nh_, name_, options_, &mutex_, std::move(hooks));
   std::ostringstream summary;
   summary << name_ << ": simulating a leader and " << followers_.size() << " follower(s)";
   if (scenario_.formation.configured) {
@@ -165,7 +175,9 @@ void PlantWorld::onCommand(Agent* agent, const geometry_msgs::AccelStamped::Cons
 }
 
 bool PlantWorld::tick(long k) {
-  const double t = static_cast<double>(k) / options_.rate;
+  if (options_.lockstep && k > 0) {
+    advanceAll(k - 1);  // [t_k-1, t_k] with the commands that answered sample k - 1
+  }
   const ros::Time stamp = clock_->stampOf(k);
 
   // Sample: odometry, tf, relative measurements.
@@ -201,12 +213,29 @@ bool PlantWorld::tick(long k) {
     return false;
   }
 
-  // Integrate every agent to t_{k+1} with its command held; the leader under u_d.
+  if (!options_.lockstep) {
+    advanceAll(k);  // in lockstep tick k + 1 does it, once the answers to sample k are in
+  }
+  return true;
+}
+
+void PlantWorld::advanceAll(long k) {
+  const double t = static_cast<double>(k) / options_.rate;
+  const ros::Time stamp = clock_->stampOf(k);
   advanceAgent(&leader_, t, stamp);
   for (Follower& follower : followers_) {
     advanceAgent(&follower.agent, t, stamp);
   }
-  return true;
+}
+
+bool PlantWorld::commandsAnswer(long k) const {
+  const std::int64_t due = nanosecondsOf(clock_->stampOf(k));
+  const auto answered = [due](const Agent& agent) {
+    return !agent.command_guard.haveAccepted() || agent.command_guard.lastStamp() >= due;
+  };
+  return answered(leader_) &&
+         std::all_of(followers_.begin(), followers_.end(),
+                     [&](const Follower& follower) { return answered(follower.agent); });
 }
 
 void PlantWorld::advanceAgent(Agent* agent, double t, const ros::Time& stamp) {

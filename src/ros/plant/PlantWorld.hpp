@@ -40,7 +40,9 @@ namespace projection_collision_avoidance {
 /// (visualization_msgs/MarkerArray: agents, names, and a line from each follower to its target)
 /// and, with publish_clock, /clock = t_k; then it integrates every agent to t_{k+1} and publishes
 /// the command it held over that step as `leader/applied_command` and
-/// `<follower>/applied_command`.
+/// `<follower>/applied_command`. With ~lockstep tick k + 1 does that integration instead, once
+/// the commands answering sample k are in (PlantClock holds simulated time until then), so
+/// that every agent integrates [t_k, t_k+1] with its answer to t_k, as cf_sim does.
 ///
 /// Time: PlantClock. With publish_clock the plant owns simulated time (stamps t_k from 0), ticking
 /// on a wall timer at rate * real_time_factor (catching up ticks that a late callback missed).
@@ -84,6 +86,10 @@ class PlantWorld {
   void publishMeasurement(int index, long k);
   /// Publishes the command the agent's tick k at time t (s) integrates, and integrates it.
   void advanceAgent(Agent* agent, double t, const ros::Time& stamp);
+  /// Integrates every agent over [t_k, t_k+1] with its command held; the leader under u_d.
+  void advanceAll(long k);
+  /// Lockstep: whether every agent that has commanded has a command stamped at or after t_k.
+  bool commandsAnswer(long k) const;
   void publishMarkers(const ros::Time& stamp);
   /// The agent a follower is measured against.
   const Agent& targetOf(const Follower& follower) const;

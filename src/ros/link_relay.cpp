@@ -1,0 +1,7 @@
+#include "projection_collision_avoidance/ros/LinkRelay.hpp"
+#include "projection_collision_avoidance/ros/NodeMain.hpp"
+
+int main(int argc, char** argv) {
+  return projection_collision_avoidance::runNode<projection_collision_avoidance::LinkRelay>(
+      argc, argv, "link_relay");
+}
