@@ -87,10 +87,9 @@ struct FollowerCycleOutput {
 /// ages, runs one step of the controller and fills a FollowerCycleOutput. With a time headway
 /// (time_headway > 0) a step with a measurement uses the own state while it is younger than the
 /// measurement timeout (RuntimeFollowerController::stepWithOwnState()), else leaves the headway
-/// out. Nothing in tick() or
-/// stepOnMeasurement() allocates, locks (except under the measurement trigger, whose steps
-/// run in the measurement's callback, and a tick waits for a step running there) or makes a
-/// system call, so that a real-time thread can run it.
+/// out. Nothing in tick() or stepOnMeasurement() allocates, locks (except under the measurement
+/// trigger, whose steps run in the measurement's callback, and a tick waits for a step running
+/// there) or makes a system call, so that a real-time thread can run it.
 ///
 /// Time: every call gives the ROS time `now_ns`. An input is valid while it was received at or
 /// before now (after a jump back of ROS time, those of the old timeline are not, so the follower

@@ -37,9 +37,9 @@ struct FollowerInputStats {
 /// headway (time_headway > 0), `odom` (nav_msgs/Odometry: its own state; frame ~odom_frame,
 /// refused once older than ~measurement_timeout on arrival), judges each message with its
 /// InputGuard (doc/boundary.md) on the subscriber's thread, and writes what it accepts into the
-/// control cycle's lock-free slots. With ~trigger measurement, each accepted
-/// measurement runs the cycle's step at once and hands its output to @p on_step. Nothing a
-/// message carries can end the node (admitGuarded()). The subscriptions start with start().
+/// control cycle's lock-free slots. With ~trigger measurement, each accepted measurement runs
+/// the cycle's step at once and hands its output to @p on_step. Nothing a message carries can
+/// end the node (admitGuarded()). The subscriptions start with start().
 class FollowerInputs {
  public:
   using StepSink = std::function<void(const FollowerCycleOutput&)>;
