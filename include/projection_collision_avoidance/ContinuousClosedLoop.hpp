@@ -36,12 +36,13 @@ struct ContinuousLoopSignals {
 /// the model of its Sec. IV:
 ///   x_1' = A x_1 + B u_1 + u_d,   x_2' = A x_2 + B u_2,   u_2 = sat(G y + u_a + u_ff) (10),
 ///   u_a = G_e (y - C xi_hat) + S_21 C xi_hat (19),
-///   xi_hat' = Proj(h),  h = A_c xi_hat - B u_a + L (C xi_hat - y) [+ B (a_1 - u_ff)] (11)-(15),
+///   xi_hat' = Proj(h),  h = A_c xi_hat - B u_acts + L (C xi_hat - y) [+ B (a_1 - u_ff)] (11)-(15),
 /// with y = C (x_1 - x_2 - d), a_1 = u_1 [+ pinv(B) u_d] and u_ff = a_1 as configured by
 /// controller.leader_information (else 0), and Proj the Gamma^-1-weighted operator of the notes.
-/// sat() is the controller's: none unless controller.acceleration_limit is set. The same
-/// equations as FollowerController, each from PaperLaws.hpp, except that u_a and y are not held
-/// over a period. The controller's rate limit (controller.jerk_limit), a bound per control
+/// sat() is the controller's: none unless controller.acceleration_limit is set. u_acts is the
+/// augmentation that acts: u_a, or u_2 - G y - u_ff while sat() acts (actingAugmentation()). The
+/// same equations as FollowerController, each from PaperLaws.hpp, except that u_2 and y are not
+/// held over a period. The controller's rate limit (controller.jerk_limit), a bound per control
 /// period, has no counterpart here and is refused, and so are the time headway (S1) and the
 /// shaped feed-forward (S2), which only the sampled loop models.
 template <typename Dims>
@@ -112,17 +113,20 @@ class ContinuousClosedLoop {
     }
     const InputVector baseline = baselineCommand<Dims>(baseline_gain_, y);  // (2)
     InputVector command;
-    augmentedCommand<Dims>(baseline, tracker, feedforward, nullptr, acceleration_limit_,
-                           &command);  // (10)
+    const bool saturated =  // (10)
+        augmentedCommand<Dims>(baseline, tracker, feedforward, nullptr, acceleration_limit_,
+                               &command);
 
-    // (11)
+    // (11) with the augmentation that acts, as the sampled controller's estimator integrates it
+    const InputVector acting =
+        saturated ? actingAugmentation(command, baseline, feedforward) : tracker;
     StateVector known_drift = StateVector::Zero(input_matrix_.rows());
     if (in_estimator_) {
       known_drift = leaderInputDrift<Dims>(input_matrix_, acceleration, feedforward);
     }
     const StateVector drift = estimatorDrift<Dims>(
         estimator_matrix_, z.estimate,
-        estimatorHeldInput<Dims>(input_matrix_, observer_gain_, y, tracker, known_drift));
+        estimatorHeldInput<Dims>(input_matrix_, observer_gain_, y, acting, known_drift));
     bool active = false;
     derivative->estimate = projectDrift(constraint_, z.estimate, drift, gamma_inverse_, &active);
     derivative->leader = state_matrix_ * z.leader + input_matrix_ * leader_input + disturbance;
