@@ -56,6 +56,20 @@ double clampNorm(Eigen::MatrixBase<Derived>& x, double radius) {
   return norm;
 }
 
+/// Hard bound (4) of transient stability (Definition 1.1): xi_max = (1 - alpha) ||d|| (m), the
+/// radius of Omega_1.
+inline double hardBound(double alpha, double separation_norm) {
+  return (1.0 - alpha) * separation_norm;
+}
+
+/// Soft bound (14a): xi_max / sqrt(1 + epsilon) (m), the radius of Omega_0 = {f <= 0}.
+inline double softBound(double xi_max, double epsilon) { return xi_max / std::sqrt(1.0 + epsilon); }
+
+/// Safety perimeter alpha ||d|| (m): the least separation of the positions while (4) holds.
+inline double safetyPerimeter(double alpha, double separation_norm) {
+  return alpha * separation_norm;
+}
+
 /// The convex constraint (13) of the CF estimator:
 /// f(x) = ((1 + eps) ||x||^2 - xi_max^2) / (eps xi_max^2),
 /// whose sub-level sets are the soft ball Omega_0 = {f <= 0} of radius xi_max / sqrt(1 + eps)
@@ -104,7 +118,7 @@ class BallConstraint {
   /// Radius of Omega_1 (m).
   double hardRadius() const { return xi_max_; }
   /// Radius of Omega_0 (m).
-  double softRadius() const { return xi_max_ / std::sqrt(1.0 + epsilon_); }
+  double softRadius() const { return softBound(xi_max_, epsilon_); }
   double epsilon() const { return epsilon_; }
 
  private:

@@ -7,6 +7,7 @@
 
 #include "projection_collision_avoidance/BallConstraint.hpp"
 #include "projection_collision_avoidance/ControllerDesign.hpp"
+#include "projection_collision_avoidance/PaperLaws.hpp"
 #include "projection_collision_avoidance/ProjectionOperator.hpp"
 #include "projection_collision_avoidance/TypeDefs.hpp"
 
@@ -95,12 +96,13 @@ class CollisionFreeEstimator {
 
   const BallConstraint& constraint() const { return constraint_; }
 
-  /// Unprojected drift (11): h = A_c xi_hat - B u_a + L (C xi_hat - y) + w, written as
-  /// (A_c + L C) xi_hat + c with c = -B u_a - L y + w.
-  /// @param w known input drift (m/s), B (u_1 - u_ff) when the leader's input is shared, else 0
+  /// The held part c = w - B u_a - L y of the unprojected drift (11), estimatorHeldInput(): h =
+  /// A_c xi_hat - B u_a + L (C xi_hat - y) + w = (A_c + L C) xi_hat + c (estimatorDrift()).
+  /// @param w known input drift (m/s), B (u_1 - u_ff) when the leader's input is shared
+  ///        (leaderInputDrift()), else 0
   StateVector heldInput(const OutputVector& y, const InputVector& tracker_input,
                         const StateVector& w) const {
-    return w - input_matrix_ * tracker_input - observer_gain_ * y;
+    return estimatorHeldInput<Dims>(input_matrix_, observer_gain_, y, tracker_input, w);
   }
 
   /// Projected derivative xi_hat' at @p estimate for the held input c (m/s).
@@ -111,7 +113,8 @@ class CollisionFreeEstimator {
 
   /// Advances the estimate over one control period with y and u_a held (15).
   /// @param y relative measurement C xi at the start of the period
-  /// @param tracker_input u_a applied over the period (m/s^2)
+  /// @param tracker_input the augmentation that acts over the period (m/s^2): u_a, or
+  ///        actingAugmentation() when a limit cut the command
   /// @param w known input drift (m/s), see heldInput()
   /// @param period control period T (s), > 0
   /// @param substeps number of RK4 steps, >= 1
@@ -133,7 +136,7 @@ class CollisionFreeEstimator {
  private:
   StateVector projectedDerivative(const StateMatrix& F, const StateVector& estimate,
                                   const StateVector& held_input, bool* active) const {
-    const StateVector drift = F * estimate + held_input;
+    const StateVector drift = estimatorDrift<Dims>(F, estimate, held_input);
     return projectDrift(constraint_, estimate, drift, gamma_inverse_, active);
   }
 

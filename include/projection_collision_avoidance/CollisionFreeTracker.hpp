@@ -1,6 +1,7 @@
 #pragma once
 
 #include "projection_collision_avoidance/ControllerDesign.hpp"
+#include "projection_collision_avoidance/PaperLaws.hpp"
 #include "projection_collision_avoidance/TypeDefs.hpp"
 
 namespace projection_collision_avoidance {
@@ -20,12 +21,13 @@ class CollisionFreeTracker {
         tracking_gain_(design.parameters.tracker_gain),
         reference_gain_(design.parameters.reference_gain) {}
 
-  /// u_a (19) for the measurement y = C xi and the estimate's output y_hat = C xi_hat.
+  /// u_a (19), trackerCommand(), for the measurement y = C xi and the estimate's output
+  /// y_hat = C xi_hat; zero when disabled.
   InputVector command(const OutputVector& y, const OutputVector& estimated_output) const {
     if (!enabled_) {
       return InputVector::Zero(tracking_gain_.rows());
     }
-    return tracking_gain_ * (y - estimated_output) + reference_gain_ * estimated_output;
+    return trackerCommand<Dims>(tracking_gain_, reference_gain_, y, estimated_output);
   }
 
   bool enabled() const { return enabled_; }

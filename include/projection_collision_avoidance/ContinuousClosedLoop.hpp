@@ -4,7 +4,9 @@
 #include <stdexcept>
 
 #include "projection_collision_avoidance/BallConstraint.hpp"
+#include "projection_collision_avoidance/CollisionFreeTracker.hpp"
 #include "projection_collision_avoidance/ControllerDesign.hpp"
+#include "projection_collision_avoidance/PaperLaws.hpp"
 #include "projection_collision_avoidance/ParameterError.hpp"
 #include "projection_collision_avoidance/ProjectionOperator.hpp"
 #include "projection_collision_avoidance/TypeDefs.hpp"
@@ -34,14 +36,15 @@ struct ContinuousLoopSignals {
 /// the model of its Sec. IV:
 ///   x_1' = A x_1 + B u_1 + u_d,   x_2' = A x_2 + B u_2,   u_2 = sat(G y + u_a + u_ff) (10),
 ///   u_a = G_e (y - C xi_hat) + S_21 C xi_hat (19),
-///   xi_hat' = Proj(h),  h = A_c xi_hat - B u_a + L (C xi_hat - y) [+ B (a_1 - u_ff)] (11)-(15),
+///   xi_hat' = Proj(h),  h = A_c xi_hat - B u_acts + L (C xi_hat - y) [+ B (a_1 - u_ff)] (11)-(15),
 /// with y = C (x_1 - x_2 - d), a_1 = u_1 [+ pinv(B) u_d] and u_ff = a_1 as configured by
 /// controller.leader_information (else 0), and Proj the Gamma^-1-weighted operator of the notes.
-/// sat() is the controller's: none unless controller.acceleration_limit is set. The same
-/// equations as FollowerController, except that u_a and y are not held over a period. The
-/// controller's rate limit (controller.jerk_limit), a bound per control period, has no
-/// counterpart here and is refused, and so are the time headway (S1) and the shaped feed-forward
-/// (S2), which only the sampled loop models.
+/// sat() is the controller's: none unless controller.acceleration_limit is set. u_acts is the
+/// augmentation that acts: u_a, or u_2 - G y - u_ff while sat() acts (actingAugmentation()). The
+/// same equations as FollowerController, each from PaperLaws.hpp, except that u_2 and y are not
+/// held over a period. The controller's rate limit (controller.jerk_limit), a bound per control
+/// period, has no counterpart here and is refused, and so are the time headway (S1) and the
+/// shaped feed-forward (S2), which only the sampled loop models.
 template <typename Dims>
 class ContinuousClosedLoop {
  public:
@@ -56,8 +59,8 @@ class ContinuousClosedLoop {
   ///        key otherwise)
   explicit ContinuousClosedLoop(const ControllerDesign& design)
       : constraint_(design.xi_max, design.parameters.epsilon),
+        tracker_(design),
         acceleration_limit_(design.parameters.acceleration_limit),
-        tracker_enabled_(design.parameters.tracker_enabled),
         share_disturbance_(design.parameters.leader_disturbance_shared),
         in_command_(design.parameters.leader_input_in_command),
         in_estimator_(design.parameters.leader_input_in_estimator) {
@@ -83,8 +86,6 @@ class ContinuousClosedLoop {
     output_matrix_ = model.C;
     separation_ = design.parameters.separation;
     baseline_gain_ = design.parameters.baseline_gain;
-    tracker_gain_ = design.parameters.tracker_gain;
-    reference_gain_ = design.parameters.reference_gain;
     estimator_matrix_ = design.estimator_matrix;
     observer_gain_ = design.parameters.estimator_gain;
     gamma_inverse_ = design.gamma_inverse;
@@ -102,28 +103,30 @@ class ContinuousClosedLoop {
     const StateVector xi = z.leader - z.follower - separation_;
     const OutputVector y = output_matrix_ * xi;
     const OutputVector estimated_output = output_matrix_ * z.estimate;
-    InputVector tracker = InputVector::Zero(input_matrix_.cols());
-    if (tracker_enabled_) {
-      tracker = tracker_gain_ * (y - estimated_output) + reference_gain_ * estimated_output;
-    }
-    InputVector acceleration = leader_input;  // a_1
-    if (share_disturbance_) {
-      acceleration += input_pseudoinverse_ * disturbance;
-    }
+    const InputVector tracker = tracker_.command(y, estimated_output);  // (19)
+    const InputVector acceleration =
+        share_disturbance_ ? leaderAcceleration(leader_input, input_pseudoinverse_, disturbance)
+                           : leader_input;  // a_1
     InputVector feedforward = InputVector::Zero(input_matrix_.cols());
     if (in_command_) {
       feedforward = acceleration;
     }
-    const InputVector baseline = baseline_gain_ * y;
-    InputVector command = baseline + tracker + feedforward;
-    clampNorm(command, acceleration_limit_);
+    const InputVector baseline = baselineCommand<Dims>(baseline_gain_, y);  // (2)
+    InputVector command;
+    const bool saturated =  // (10)
+        augmentedCommand<Dims>(baseline, tracker, feedforward, nullptr, acceleration_limit_,
+                               &command);
 
-    // h = (A_c + L C) xi_hat - L y - B u_a = A_c xi_hat - B u_a + L (C xi_hat - y)
-    StateVector drift =
-        estimator_matrix_ * z.estimate - observer_gain_ * y - input_matrix_ * tracker;
+    // (11) with the augmentation that acts, as the sampled controller's estimator integrates it
+    const InputVector acting =
+        saturated ? actingAugmentation(command, baseline, feedforward) : tracker;
+    StateVector known_drift = StateVector::Zero(input_matrix_.rows());
     if (in_estimator_) {
-      drift += input_matrix_ * (acceleration - feedforward);
+      known_drift = leaderInputDrift<Dims>(input_matrix_, acceleration, feedforward);
     }
+    const StateVector drift = estimatorDrift<Dims>(
+        estimator_matrix_, z.estimate,
+        estimatorHeldInput<Dims>(input_matrix_, observer_gain_, y, acting, known_drift));
     bool active = false;
     derivative->estimate = projectDrift(constraint_, z.estimate, drift, gamma_inverse_, &active);
     derivative->leader = state_matrix_ * z.leader + input_matrix_ * leader_input + disturbance;
@@ -143,8 +146,8 @@ class ContinuousClosedLoop {
 
  private:
   BallConstraint constraint_;
+  CollisionFreeTracker<Dims> tracker_;  // (19)
   double acceleration_limit_;
-  bool tracker_enabled_;
   bool share_disturbance_;
   bool in_command_;
   bool in_estimator_;
@@ -153,8 +156,6 @@ class ContinuousClosedLoop {
   typename Dims::OutputMatrix output_matrix_;           // C
   StateVector separation_;                              // d
   typename Dims::FeedbackGainMatrix baseline_gain_;     // G
-  typename Dims::FeedbackGainMatrix tracker_gain_;      // G_e
-  typename Dims::FeedbackGainMatrix reference_gain_;    // S_21
   typename Dims::StateMatrix estimator_matrix_;         // A_c + L C
   typename Dims::ObserverGainMatrix observer_gain_;     // L
   typename Dims::StateMatrix gamma_inverse_;            // Gamma^-1

@@ -6,6 +6,7 @@
 #include "projection_collision_avoidance/CommandRateLimiter.hpp"
 #include "projection_collision_avoidance/ControllerDesign.hpp"
 #include "projection_collision_avoidance/FollowerControllerStatus.hpp"
+#include "projection_collision_avoidance/PaperLaws.hpp"
 #include "projection_collision_avoidance/PlatoonLaws.hpp"
 #include "projection_collision_avoidance/TypeDefs.hpp"
 
@@ -205,16 +206,16 @@ class FollowerController {
     const StateVector& estimate = estimator_.estimate();
     const OutputVector estimated_output = output_matrix_ * estimate;
 
-    status_.baseline_command = baseline_gain_ * y;
-    status_.tracker_command = tracker_.command(y, estimated_output);
-    status_.command =
-        status_.baseline_command + status_.tracker_command + status_.feedforward_command;
+    status_.baseline_command = baselineCommand<Dims>(baseline_gain_, y);  // (2)
+    status_.tracker_command = tracker_.command(y, estimated_output);      // (19)
     const bool headway = headway_ && own_state != nullptr && own_state->allFinite();
     status_.headway_command.setZero();
     if (headway) {  // (S1)
       status_.headway_command = headway_gain_ * (*own_state);
-      status_.command += status_.headway_command;
     }
+    status_.command_saturated = augmentedCommand<Dims>(  // (10); an overflow stays not finite
+        status_.baseline_command, status_.tracker_command, status_.feedforward_command,
+        headway ? &status_.headway_command : nullptr, p.acceleration_limit, &status_.command);
     if (!status_.command.allFinite()) {
       status_.command_overflow = true;
       return false;
@@ -224,14 +225,13 @@ class FollowerController {
     status_.constraint_value = estimator_.constraint().value(estimate);
     status_.fallback_command.setZero();
     status_.fallback = false;
-    limitCommand();
-    InputVector acting_augmentation = status_.tracker_command;
-    if (headway) {
-      acting_augmentation += status_.headway_command;
-    }
+    status_.command_rate_limited = rate_limiter_.limit(status_.command);
+    InputVector acting_augmentation = status_.tracker_command;  // u_a [+ K_h x_2], unless cut
     if (status_.command_saturated || status_.command_rate_limited) {
-      acting_augmentation =
-          status_.command - status_.baseline_command - status_.feedforward_command;
+      acting_augmentation = actingAugmentation(status_.command, status_.baseline_command,
+                                               status_.feedforward_command);
+    } else if (headway) {
+      acting_augmentation += status_.headway_command;
     }
 
     const StateVector known_drift = knownDrift(leader_input, leader_input_known);
@@ -277,7 +277,7 @@ class FollowerController {
   /// w = B (u_1 - u_ff) when the leader's input is shared into the estimator, else 0 (m/s).
   StateVector knownDrift(const InputVector& leader_input, bool leader_input_known) const {
     if (leader_input_known && design_.parameters.leader_input_in_estimator) {
-      return input_matrix_ * (leader_input - status_.feedforward_command);
+      return leaderInputDrift<Dims>(input_matrix_, leader_input, status_.feedforward_command);
     }
     return StateVector::Zero(input_matrix_.rows());
   }
@@ -294,12 +294,12 @@ class FollowerController {
     }
   }
 
-  /// Scales the finite status_.command onto acceleration_limit when it is longer (clampNorm():
-  /// no overflow, and euclideanNorm(command) <= acceleration_limit exactly), then limits its
-  /// change from the previous tick's command to jerk_limit T, inside the same ball.
+  /// The fallback's limits: sat() of (10) (saturateCommand(): euclideanNorm(command) <=
+  /// acceleration_limit exactly, no overflow), then the change from the previous tick's command
+  /// limited to jerk_limit T, inside the same ball.
   void limitCommand() {
     status_.command_saturated =
-        clampNorm(status_.command, design_.parameters.acceleration_limit) > 0.0;
+        saturateCommand(&status_.command, design_.parameters.acceleration_limit);
     status_.command_rate_limited = rate_limiter_.limit(status_.command);
   }
 

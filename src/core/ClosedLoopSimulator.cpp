@@ -13,6 +13,7 @@
 #include "projection_collision_avoidance/ControllerDesign.hpp"
 #include "projection_collision_avoidance/DimensionDispatch.hpp"
 #include "projection_collision_avoidance/FollowerController.hpp"
+#include "projection_collision_avoidance/PaperLaws.hpp"
 #include "projection_collision_avoidance/ParameterError.hpp"
 #include "projection_collision_avoidance/SharedLink.hpp"
 
@@ -107,10 +108,9 @@ FormationSummary runFormation(const Scenario& scenario, const ControllerDesign& 
     if (need_disturbance) {
       scenario.disturbance.addTo(t, disturbance);
     }
-    InputVector leader_acceleration = leader_input;  // a_1 = u_1 (+ pinv(B) u_d)
-    if (share_disturbance) {
-      leader_acceleration += input_pseudoinverse * disturbance;
-    }
+    const InputVector leader_acceleration =  // a_1 = u_1 (+ pinv(B) u_d)
+        share_disturbance ? leaderAcceleration(leader_input, input_pseudoinverse, disturbance)
+                          : leader_input;
     if (use_link) {
       link.send(0, tick, leader_acceleration);
     }

@@ -9,7 +9,9 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
 
+#include "projection_collision_avoidance/BallConstraint.hpp"
 #include "projection_collision_avoidance/LinearAlgebra.hpp"
+#include "projection_collision_avoidance/PaperLaws.hpp"
 #include "projection_collision_avoidance/ParameterError.hpp"
 #include "projection_collision_avoidance/PlatoonLaws.hpp"
 
@@ -248,16 +250,17 @@ ControllerDesign ControllerDesign::create(const ControllerParameters& parameters
   design.headway_gain = timeHeadwayGain(p);
   design.feedforward_smoothing = feedforwardSmoothing(p);
   const double d_norm = p.separation.norm();
-  design.xi_max = (1.0 - p.alpha) * d_norm;
-  design.xi_soft = design.xi_max / std::sqrt(1.0 + p.epsilon);
-  design.perimeter = p.alpha * d_norm;
+  design.xi_max = hardBound(p.alpha, d_norm);
+  design.xi_soft = softBound(design.xi_max, p.epsilon);
+  design.perimeter = safetyPerimeter(p.alpha, d_norm);
   return design;
 }
 
 Eigen::VectorXd ControllerDesign::leaderAcceleration(const Eigen::VectorXd& leader_input,
                                                      const Eigen::VectorXd& disturbance) const {
   if (parameters.leader_disturbance_shared && disturbance.size() > 0) {
-    return leader_input + input_pseudoinverse * disturbance;
+    return projection_collision_avoidance::leaderAcceleration(leader_input, input_pseudoinverse,
+                                                              disturbance);
   }
   return leader_input;
 }

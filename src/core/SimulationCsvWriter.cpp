@@ -1,8 +1,9 @@
 #include "projection_collision_avoidance/SimulationCsvWriter.hpp"
 
-#include <cmath>
 #include <ostream>
 #include <string>
+
+#include "projection_collision_avoidance/BallConstraint.hpp"
 
 namespace projection_collision_avoidance {
 namespace {
@@ -27,9 +28,10 @@ SimulationCsvWriter::SimulationCsvWriter(std::ostream& out, const Scenario& scen
       inputs_(scenario.controller.model.inputDimension()),
       positions_(scenario.controller.model.position_dimension),
       velocities_(scenario.controller.model.isDoubleIntegrator()),
-      xi_max_((1.0 - scenario.controller.alpha) * scenario.controller.separation.norm()),
-      xi_soft_(xi_max_ / std::sqrt(1.0 + scenario.controller.epsilon)),  // xi_max_ is set above
-      perimeter_(scenario.controller.alpha * scenario.controller.separation.norm()) {
+      xi_max_(hardBound(scenario.controller.alpha, scenario.controller.separation.norm())),
+      xi_soft_(softBound(xi_max_, scenario.controller.epsilon)),  // xi_max_ is set above
+      perimeter_(
+          safetyPerimeter(scenario.controller.alpha, scenario.controller.separation.norm())) {
   out_.precision(17);  // round-trip: a reader gets the very doubles
   out_ << 't';
   writeHeaderColumns(out_, "xi_", states_);

@@ -9,6 +9,7 @@
 
 #include "projection_collision_avoidance/AgentIntegrator.hpp"
 #include "projection_collision_avoidance/ClosedLoopSimulator.hpp"
+#include "projection_collision_avoidance/ContinuousClosedLoop.hpp"
 #include "projection_collision_avoidance/ControllerDesign.hpp"
 #include "projection_collision_avoidance/FollowerController.hpp"
 #include "projection_collision_avoidance/RuntimeFollowerController.hpp"
@@ -137,6 +138,54 @@ TEST(NoAllocation, ControlStepsWithTheRateLimitActive) {
   }
   EXPECT_EQ(testing::allocationCount() - before, 0);
   EXPECT_GT(limited, 100);
+}
+
+/// Allocations during evaluations of the continuous loop's right-hand side z' (evaluate()), with
+/// the leader's input shared and the acceleration limit (1 m/s^2) acting; @p saturated counts
+/// the evaluations whose command the limit scaled.
+template <typename Dims>
+long allocationsDuringEvaluations(const ControllerDesign& design, int evaluations, int* saturated) {
+  const ContinuousClosedLoop<Dims> loop(design);
+  const Eigen::Index n = design.parameters.model.stateDimension();
+  typename ContinuousClosedLoop<Dims>::State z;
+  typename ContinuousClosedLoop<Dims>::State derivative;
+  typename ContinuousClosedLoop<Dims>::Signals signals;
+  z.follower = Dims::StateVector::Zero(n);
+  z.estimate = Dims::StateVector::Constant(n, 0.1);
+  const typename Dims::InputVector u1 =
+      Dims::InputVector::Constant(design.parameters.model.inputDimension(), 0.3);
+  const typename Dims::StateVector ud = Dims::StateVector::Constant(n, -0.2);
+  const typename Dims::StateVector separation = design.parameters.separation;
+  const long before = testing::allocationCount();
+  for (int k = 0; k < evaluations; ++k) {
+    z.leader = separation + Dims::StateVector::Constant(n, (k % 2) * 3.0);
+    loop.evaluate(z, u1, ud, &derivative, &signals);
+    *saturated +=
+        signals.command.norm() > design.parameters.acceleration_limit * (1.0 - 1e-12) ? 1 : 0;
+  }
+  return testing::allocationCount() - before;
+}
+
+TEST(NoAllocation, ContinuousLoopEvaluations) {
+  for (const int axes : {1, 3}) {
+    Scenario scenario = loadScenarioFile(testing::scenarioPath("paper_run2.yaml"));
+    scenario.controller.leader_input_in_command = true;
+    scenario.controller.leader_input_in_estimator = true;
+    scenario.controller.leader_disturbance_shared = true;
+    scenario.controller.acceleration_limit = 1.0;
+    if (axes > 1) {
+      scenario = embedAlongDirection(scenario, Eigen::VectorXd::Ones(axes));
+    }
+    const ControllerDesign design = ControllerDesign::create(scenario.controller);
+    int saturated = 0;
+    if (axes == 1) {
+      EXPECT_EQ(allocationsDuringEvaluations<DoubleIntegrator1D>(design, 1000, &saturated), 0);
+    } else {
+      EXPECT_EQ(allocationsDuringEvaluations<DoubleIntegrator3D>(design, 1000, &saturated), 0);
+      EXPECT_EQ(allocationsDuringEvaluations<GenericDimensions>(design, 1000, &saturated), 0);
+    }
+    EXPECT_GE(saturated, axes == 1 ? 500 : 1000) << axes << " axes";
+  }
 }
 
 TEST(NoAllocation, DisturbedAgentStepsAwayFromPulseEdges) {
