@@ -2,27 +2,34 @@
 # package's CMakeLists.txt and the standalone sanitizer/fuzzer project
 # (test/sanitize/CMakeLists.txt, which prefixes them with the root).
 
-# projection_collision_avoidance_core: every equation of the controller (Eigen and std only).
+# projection_collision_avoidance_core: the controller, every law of the paper (Eigen and std only).
 set(PCA_CORE_SOURCES
-  src/core/AgentIntegrator.cpp
   src/core/AgentModel.cpp
-  src/core/ClosedLoopSimulator.cpp
-  src/core/ContinuousSimulator.cpp
   src/core/ControllerDesign.cpp
-  src/core/DisturbanceSweep.cpp
+  src/core/DynamicFollowerController.cpp
   src/core/ExactDiscretization.cpp
   src/core/FollowerController.cpp
   src/core/FollowerMode.cpp
   src/core/Formation.cpp
   src/core/LinearAlgebra.cpp
   src/core/PlatoonLaws.cpp
-  src/core/RuntimeFollowerController.cpp
-  src/core/Scenario.cpp
-  src/core/ScenarioEmbedding.cpp
-  src/core/SharedLink.cpp
-  src/core/SignalProfile.cpp
-  src/core/SimulationCsvWriter.cpp
-  src/core/StringStability.cpp
+)
+
+# projection_collision_avoidance_sim: simulation and experiment tooling around the controller
+# (the plant, the sampled and continuous loops, sweeps, the measurement channel and the link of
+# shared information); Eigen and std only.
+set(PCA_SIM_SOURCES
+  src/sim/AgentIntegrator.cpp
+  src/sim/ContinuousSimulator.cpp
+  src/sim/DisturbanceSweep.cpp
+  src/sim/MeasurementChannel.cpp
+  src/sim/SampledSimulator.cpp
+  src/sim/Scenario.cpp
+  src/sim/ScenarioEmbedding.cpp
+  src/sim/SharedLink.cpp
+  src/sim/SignalProfile.cpp
+  src/sim/SimulationCsvWriter.cpp
+  src/sim/StringStability.cpp
 )
 
 # projection_collision_avoidance_scenario: scenario files (libyaml parses them into yaml-cpp

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "projection_collision_avoidance/CfSimApp.hpp"
+#include "projection_collision_avoidance/scenario/CfSimApp.hpp"
 
 int main(int argc, char** argv) {
   // argv/argc is the C interface of main(); this is the one place it is turned into a range.

@@ -1,7 +1,7 @@
-#include "projection_collision_avoidance/AgentModel.hpp"
+#include "projection_collision_avoidance/core/AgentModel.hpp"
 
-#include "projection_collision_avoidance/ParameterError.hpp"
-#include "projection_collision_avoidance/TypeDefs.hpp"
+#include "projection_collision_avoidance/core/ParameterError.hpp"
+#include "projection_collision_avoidance/core/TypeDefs.hpp"
 
 #include "ValidationChecks.hpp"
 

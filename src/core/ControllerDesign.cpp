@@ -1,4 +1,4 @@
-#include "projection_collision_avoidance/ControllerDesign.hpp"
+#include "projection_collision_avoidance/core/ControllerDesign.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -9,11 +9,11 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
 
-#include "projection_collision_avoidance/BallConstraint.hpp"
-#include "projection_collision_avoidance/LinearAlgebra.hpp"
-#include "projection_collision_avoidance/PaperLaws.hpp"
-#include "projection_collision_avoidance/ParameterError.hpp"
-#include "projection_collision_avoidance/PlatoonLaws.hpp"
+#include "projection_collision_avoidance/core/BallConstraint.hpp"
+#include "projection_collision_avoidance/core/LinearAlgebra.hpp"
+#include "projection_collision_avoidance/core/PaperLaws.hpp"
+#include "projection_collision_avoidance/core/ParameterError.hpp"
+#include "projection_collision_avoidance/core/PlatoonLaws.hpp"
 
 #include "ValidationChecks.hpp"
 

@@ -1,4 +1,4 @@
-#include "projection_collision_avoidance/ExactDiscretization.hpp"
+#include "projection_collision_avoidance/core/ExactDiscretization.hpp"
 
 #include <unsupported/Eigen/MatrixFunctions>
 

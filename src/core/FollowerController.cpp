@@ -1,4 +1,4 @@
-#include "projection_collision_avoidance/FollowerController.hpp"
+#include "projection_collision_avoidance/core/FollowerController.hpp"
 
 namespace projection_collision_avoidance {
 

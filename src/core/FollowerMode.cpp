@@ -1,4 +1,4 @@
-#include "projection_collision_avoidance/FollowerMode.hpp"
+#include "projection_collision_avoidance/core/FollowerMode.hpp"
 
 namespace projection_collision_avoidance {
 

@@ -1,9 +1,9 @@
-#include "projection_collision_avoidance/Formation.hpp"
+#include "projection_collision_avoidance/core/Formation.hpp"
 
 #include <cmath>
 #include <cstddef>
 
-#include "projection_collision_avoidance/ParameterError.hpp"
+#include "projection_collision_avoidance/core/ParameterError.hpp"
 
 namespace projection_collision_avoidance {
 namespace {

@@ -1,4 +1,4 @@
-#include "projection_collision_avoidance/LinearAlgebra.hpp"
+#include "projection_collision_avoidance/core/LinearAlgebra.hpp"
 
 #include <cmath>
 #include <sstream>

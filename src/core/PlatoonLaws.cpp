@@ -1,10 +1,10 @@
-#include "projection_collision_avoidance/PlatoonLaws.hpp"
+#include "projection_collision_avoidance/core/PlatoonLaws.hpp"
 
 #include <cmath>
 #include <string>
 
-#include "projection_collision_avoidance/LinearAlgebra.hpp"
-#include "projection_collision_avoidance/ParameterError.hpp"
+#include "projection_collision_avoidance/core/LinearAlgebra.hpp"
+#include "projection_collision_avoidance/core/ParameterError.hpp"
 
 namespace projection_collision_avoidance {
 namespace {

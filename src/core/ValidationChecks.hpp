@@ -8,8 +8,8 @@
 
 #include <Eigen/Core>
 
-#include "projection_collision_avoidance/LinearAlgebra.hpp"
-#include "projection_collision_avoidance/ParameterError.hpp"
+#include "projection_collision_avoidance/core/LinearAlgebra.hpp"
+#include "projection_collision_avoidance/core/ParameterError.hpp"
 
 namespace projection_collision_avoidance::detail {
 

@@ -35,7 +35,7 @@ std::uint32_t skippedPeriods(double gap, double period) {
              : static_cast<std::uint32_t>(skipped);
 }
 
-FollowerCycle::FollowerCycle(std::unique_ptr<RuntimeFollowerController> controller,
+FollowerCycle::FollowerCycle(std::unique_ptr<DynamicFollowerController> controller,
                              const Eigen::VectorXd& separation, FollowerCycleSettings settings)
     : controller_(std::move(controller)), separation_(separation), settings_(settings) {
   if (!controller_ || separation.size() != controller_->stateDimension()) {
@@ -50,25 +50,25 @@ FollowerCycle::~FollowerCycle() {
   delete retired_.exchange(nullptr);
 }
 
-std::unique_ptr<RuntimeFollowerController> FollowerCycle::offer(
-    std::unique_ptr<RuntimeFollowerController> controller) {
+std::unique_ptr<DynamicFollowerController> FollowerCycle::offer(
+    std::unique_ptr<DynamicFollowerController> controller) {
   if (!controller || controller->stateDimension() != controller_->stateDimension() ||
       controller->inputDimension() != controller_->inputDimension() ||
       controller->outputDimension() != controller_->outputDimension()) {
     throw std::invalid_argument("FollowerCycle::offer: a controller of the same model sizes");
   }
-  return std::unique_ptr<RuntimeFollowerController>(offered_.exchange(controller.release()));
+  return std::unique_ptr<DynamicFollowerController>(offered_.exchange(controller.release()));
 }
 
-std::unique_ptr<RuntimeFollowerController> FollowerCycle::retired() {
-  return std::unique_ptr<RuntimeFollowerController>(retired_.exchange(nullptr));
+std::unique_ptr<DynamicFollowerController> FollowerCycle::retired() {
+  return std::unique_ptr<DynamicFollowerController>(retired_.exchange(nullptr));
 }
 
 void FollowerCycle::adoptOffered() {
   if (retired_.load(std::memory_order_acquire) != nullptr) {
     return;  // the previous one is not collected yet: adopt at a later tick
   }
-  RuntimeFollowerController* next = offered_.exchange(nullptr);
+  DynamicFollowerController* next = offered_.exchange(nullptr);
   if (next == nullptr) {
     return;
   }
@@ -199,7 +199,7 @@ bool FollowerCycle::step(std::int64_t now_ns, std::int64_t stamp_ns, double dela
   out->own_state_fresh =
       design.parameters.time_headway > 0.0 && have_own_state_ &&
       ageOf(stamp_ns, own.stamp_ns, own.receipt_ns) <= settings_.measurement_timeout;
-  const RuntimeFollowerStatus* status = nullptr;
+  const DynamicFollowerStatus* status = nullptr;
   if (mode_ == FollowerMode::kMeasurementLost) {
     status = use_leader ? &controller_->stepFallback(leader_.value().acceleration)
                         : &controller_->stepFallback();

@@ -3,9 +3,9 @@
 #include <sstream>
 #include <system_error>
 
-#include "projection_collision_avoidance/ControllerDesign.hpp"
-#include "projection_collision_avoidance/ParameterError.hpp"
-#include "projection_collision_avoidance/RuntimeFollowerController.hpp"
+#include "projection_collision_avoidance/core/ControllerDesign.hpp"
+#include "projection_collision_avoidance/core/ParameterError.hpp"
+#include "projection_collision_avoidance/core/DynamicFollowerController.hpp"
 #include "projection_collision_avoidance/node/FollowerCycle.hpp"
 #include "projection_collision_avoidance/ros/RosParameters.hpp"
 
@@ -26,7 +26,7 @@ FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh,
   const FormationMember member = memberOf(reader, scenario);
   const ControllerParameters parameters = memberParameters(scenario.controller, member);
   auto controller =
-      std::make_unique<RuntimeFollowerController>(ControllerDesign::create(parameters));
+      std::make_unique<DynamicFollowerController>(ControllerDesign::create(parameters));
   const ControllerDesign& design = controller->design();
   const FollowerNodeOptions options =
       readFollowerOptions(reader, parameters, member, ros::Time::isSimTime());

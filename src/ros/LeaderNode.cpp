@@ -3,7 +3,7 @@
 #include <geometry_msgs/AccelStamped.h>
 
 #include "projection_collision_avoidance/LeaderBroadcast.h"
-#include "projection_collision_avoidance/ParameterError.hpp"
+#include "projection_collision_avoidance/core/ParameterError.hpp"
 #include "projection_collision_avoidance/ros/MessageConversions.hpp"
 #include "projection_collision_avoidance/ros/RosParameters.hpp"
 

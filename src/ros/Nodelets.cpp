@@ -7,8 +7,8 @@
 #include <nodelet/nodelet.h>
 #include <pluginlib/class_list_macros.hpp>
 
-#include "projection_collision_avoidance/ParameterError.hpp"
-#include "projection_collision_avoidance/ScenarioLoader.hpp"
+#include "projection_collision_avoidance/core/ParameterError.hpp"
+#include "projection_collision_avoidance/scenario/ScenarioLoader.hpp"
 #include "projection_collision_avoidance/ros/FollowerNode.hpp"
 #include "projection_collision_avoidance/ros/LeaderNode.hpp"
 #include "projection_collision_avoidance/ros/LinkRelay.hpp"

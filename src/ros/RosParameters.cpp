@@ -7,8 +7,8 @@
 #include <ros/console.h>
 #include <ros/init.h>
 
-#include "projection_collision_avoidance/ParameterError.hpp"
-#include "projection_collision_avoidance/ScenarioLoader.hpp"
+#include "projection_collision_avoidance/core/ParameterError.hpp"
+#include "projection_collision_avoidance/scenario/ScenarioLoader.hpp"
 
 namespace projection_collision_avoidance {
 namespace {

@@ -1,4 +1,4 @@
-#include "projection_collision_avoidance/CfSimApp.hpp"
+#include "projection_collision_avoidance/scenario/CfSimApp.hpp"
 
 #include <chrono>
 #include <cmath>
@@ -13,13 +13,13 @@
 #include <string>
 #include <vector>
 
-#include "projection_collision_avoidance/ClosedLoopSimulator.hpp"
-#include "projection_collision_avoidance/ContinuousSimulator.hpp"
-#include "projection_collision_avoidance/DisturbanceSweep.hpp"
-#include "projection_collision_avoidance/ParameterError.hpp"
-#include "projection_collision_avoidance/ScenarioLoader.hpp"
-#include "projection_collision_avoidance/SimulationCsvWriter.hpp"
-#include "projection_collision_avoidance/StringStability.hpp"
+#include "projection_collision_avoidance/sim/SampledSimulator.hpp"
+#include "projection_collision_avoidance/sim/ContinuousSimulator.hpp"
+#include "projection_collision_avoidance/sim/DisturbanceSweep.hpp"
+#include "projection_collision_avoidance/core/ParameterError.hpp"
+#include "projection_collision_avoidance/scenario/ScenarioLoader.hpp"
+#include "projection_collision_avoidance/sim/SimulationCsvWriter.hpp"
+#include "projection_collision_avoidance/sim/StringStability.hpp"
 
 namespace projection_collision_avoidance {
 namespace {

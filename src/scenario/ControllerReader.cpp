@@ -7,9 +7,9 @@
 
 #include <Eigen/Core>
 
-#include "projection_collision_avoidance/ControllerDesign.hpp"
-#include "projection_collision_avoidance/ParameterError.hpp"
-#include "projection_collision_avoidance/PlatoonLaws.hpp"
+#include "projection_collision_avoidance/core/ControllerDesign.hpp"
+#include "projection_collision_avoidance/core/ParameterError.hpp"
+#include "projection_collision_avoidance/core/PlatoonLaws.hpp"
 
 namespace projection_collision_avoidance::detail {
 namespace {

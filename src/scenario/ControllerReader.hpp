@@ -3,9 +3,9 @@
 /// @file
 /// Reads the `controller` section of a scenario (internal to the scenario library).
 
-#include "projection_collision_avoidance/AgentModel.hpp"
-#include "projection_collision_avoidance/ControllerParameters.hpp"
-#include "projection_collision_avoidance/SharedLink.hpp"
+#include "projection_collision_avoidance/core/AgentModel.hpp"
+#include "projection_collision_avoidance/core/ControllerParameters.hpp"
+#include "projection_collision_avoidance/sim/SharedLink.hpp"
 
 #include "YamlReader.hpp"
 

@@ -1,4 +1,4 @@
-#include "projection_collision_avoidance/ScenarioLoader.hpp"
+#include "projection_collision_avoidance/scenario/ScenarioLoader.hpp"
 
 #include <cmath>
 #include <cstddef>
@@ -11,8 +11,8 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include "projection_collision_avoidance/ControllerDesign.hpp"
-#include "projection_collision_avoidance/ParameterError.hpp"
+#include "projection_collision_avoidance/core/ControllerDesign.hpp"
+#include "projection_collision_avoidance/core/ParameterError.hpp"
 
 #include "ControllerReader.hpp"
 #include "YamlParser.hpp"

@@ -15,7 +15,7 @@
 #include <Eigen/Core>
 #include <yaml-cpp/yaml.h>
 
-#include "projection_collision_avoidance/ParameterError.hpp"
+#include "projection_collision_avoidance/core/ParameterError.hpp"
 
 namespace projection_collision_avoidance::detail {
 

@@ -7,10 +7,10 @@
 #include <cstdio>
 #include <string>
 
-#include "projection_collision_avoidance/ControllerDesign.hpp"
-#include "projection_collision_avoidance/FollowerController.hpp"
-#include "projection_collision_avoidance/ScenarioEmbedding.hpp"
-#include "projection_collision_avoidance/ScenarioLoader.hpp"
+#include "projection_collision_avoidance/core/ControllerDesign.hpp"
+#include "projection_collision_avoidance/core/FollowerController.hpp"
+#include "projection_collision_avoidance/sim/ScenarioEmbedding.hpp"
+#include "projection_collision_avoidance/scenario/ScenarioLoader.hpp"
 
 namespace projection_collision_avoidance {
 namespace {

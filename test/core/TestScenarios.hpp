@@ -5,8 +5,8 @@
 
 #include <string>
 
-#include "projection_collision_avoidance/ControllerParameters.hpp"
-#include "projection_collision_avoidance/ScenarioLoader.hpp"
+#include "projection_collision_avoidance/core/ControllerParameters.hpp"
+#include "projection_collision_avoidance/scenario/ScenarioLoader.hpp"
 
 namespace projection_collision_avoidance {
 namespace testing {

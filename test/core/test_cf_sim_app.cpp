@@ -7,7 +7,7 @@
 
 #include <gtest/gtest.h>
 
-#include "projection_collision_avoidance/CfSimApp.hpp"
+#include "projection_collision_avoidance/scenario/CfSimApp.hpp"
 
 #include "TestScenarios.hpp"
 

@@ -8,12 +8,12 @@
 
 #include <gtest/gtest.h>
 
-#include "projection_collision_avoidance/CommandRateLimiter.hpp"
-#include "projection_collision_avoidance/ControllerDesign.hpp"
-#include "projection_collision_avoidance/FollowerController.hpp"
-#include "projection_collision_avoidance/ParameterError.hpp"
-#include "projection_collision_avoidance/RuntimeFollowerController.hpp"
-#include "projection_collision_avoidance/ScenarioLoader.hpp"
+#include "projection_collision_avoidance/core/CommandRateLimiter.hpp"
+#include "projection_collision_avoidance/core/ControllerDesign.hpp"
+#include "projection_collision_avoidance/core/FollowerController.hpp"
+#include "projection_collision_avoidance/core/ParameterError.hpp"
+#include "projection_collision_avoidance/core/DynamicFollowerController.hpp"
+#include "projection_collision_avoidance/scenario/ScenarioLoader.hpp"
 
 #include "EigenTestHelpers.hpp"
 #include "TestScenarios.hpp"
@@ -302,7 +302,7 @@ TEST(CommandRateLimit, FallbackPredictsWithTheActingCommand) {
 }
 
 TEST(CommandRateLimit, SetDesignKeepsThePreviousCommandAndResetClearsIt) {
-  RuntimeFollowerController controller(ControllerDesign::create(planarParameters(kInf, kInf)));
+  DynamicFollowerController controller(ControllerDesign::create(planarParameters(kInf, kInf)));
   const Eigen::Vector4d y(2.0, -1.0, 0.5, 0.3);
   const Eigen::VectorXd before = controller.step(y).command;
   ASSERT_GT(before.norm(), 1.0);
@@ -310,7 +310,7 @@ TEST(CommandRateLimit, SetDesignKeepsThePreviousCommandAndResetClearsIt) {
   controller.setDesign(limited);
   EXPECT_EQ(controller.previousCommand(), before);
   const Eigen::Vector4d far(-6.0, 5.0, -2.0, 1.0);
-  const RuntimeFollowerStatus& next = controller.step(far);
+  const DynamicFollowerStatus& next = controller.step(far);
   EXPECT_TRUE(next.command_rate_limited);
   EXPECT_LE(euclideanNorm(next.command - before), 20.0 * limited.period);
   EXPECT_NEAR(euclideanNorm(next.command - before), 20.0 * limited.period, 1e-12);
@@ -322,7 +322,7 @@ TEST(CommandRateLimit, SetDesignKeepsThePreviousCommandAndResetClearsIt) {
 
   controller.reset();
   EXPECT_EQ(controller.previousCommand(), Eigen::VectorXd::Zero(2));
-  const RuntimeFollowerStatus& restarted = controller.step(far);
+  const DynamicFollowerStatus& restarted = controller.step(far);
   EXPECT_NEAR(euclideanNorm(restarted.command), 20.0 * limited.period, 1e-12);
 }
 

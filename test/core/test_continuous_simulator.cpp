@@ -1,4 +1,4 @@
-/// The continuous-time loop (ContinuousClosedLoop, simulateContinuous()): the paper's figures,
+/// The continuous-time loop (ContinuousDynamics, simulateContinuous()): the paper's figures,
 /// fourth-order convergence of RK4, the invariance of Omega_1, and the sampled controller
 /// converging to it at first order in the period.
 
@@ -8,12 +8,12 @@
 
 #include <gtest/gtest.h>
 
-#include "projection_collision_avoidance/ClosedLoopSimulator.hpp"
-#include "projection_collision_avoidance/ContinuousClosedLoop.hpp"
-#include "projection_collision_avoidance/ContinuousSimulator.hpp"
-#include "projection_collision_avoidance/ParameterError.hpp"
-#include "projection_collision_avoidance/ScenarioEmbedding.hpp"
-#include "projection_collision_avoidance/ScenarioLoader.hpp"
+#include "projection_collision_avoidance/sim/SampledSimulator.hpp"
+#include "projection_collision_avoidance/sim/ContinuousDynamics.hpp"
+#include "projection_collision_avoidance/sim/ContinuousSimulator.hpp"
+#include "projection_collision_avoidance/core/ParameterError.hpp"
+#include "projection_collision_avoidance/sim/ScenarioEmbedding.hpp"
+#include "projection_collision_avoidance/scenario/ScenarioLoader.hpp"
 
 #include "TestScenarios.hpp"
 
@@ -224,7 +224,7 @@ TEST(ContinuousSimulator, RefusesAJerkLimit) {
     EXPECT_EQ(error.key(), "controller.jerk_limit");
   }
   EXPECT_THROW(
-      (void)ContinuousClosedLoop<DoubleIntegrator1D>(ControllerDesign::create(scenario.controller)),
+      (void)ContinuousDynamics<DoubleIntegrator1D>(ControllerDesign::create(scenario.controller)),
       ParameterError);
 }
 

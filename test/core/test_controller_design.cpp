@@ -8,9 +8,9 @@
 #include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
 
-#include "projection_collision_avoidance/ControllerDesign.hpp"
-#include "projection_collision_avoidance/LinearAlgebra.hpp"
-#include "projection_collision_avoidance/ParameterError.hpp"
+#include "projection_collision_avoidance/core/ControllerDesign.hpp"
+#include "projection_collision_avoidance/core/LinearAlgebra.hpp"
+#include "projection_collision_avoidance/core/ParameterError.hpp"
 
 #include "EigenTestHelpers.hpp"
 #include "TestScenarios.hpp"

@@ -9,11 +9,11 @@
 
 #include <gtest/gtest.h>
 
-#include "projection_collision_avoidance/BallConstraint.hpp"
-#include "projection_collision_avoidance/CollisionFreeEstimator.hpp"
-#include "projection_collision_avoidance/ControllerDesign.hpp"
-#include "projection_collision_avoidance/FollowerController.hpp"
-#include "projection_collision_avoidance/RuntimeFollowerController.hpp"
+#include "projection_collision_avoidance/core/BallConstraint.hpp"
+#include "projection_collision_avoidance/core/CollisionFreeEstimator.hpp"
+#include "projection_collision_avoidance/core/ControllerDesign.hpp"
+#include "projection_collision_avoidance/core/FollowerController.hpp"
+#include "projection_collision_avoidance/core/DynamicFollowerController.hpp"
 
 #include "EigenTestHelpers.hpp"
 #include "TestScenarios.hpp"
@@ -86,14 +86,14 @@ TEST(ControllerRobustness, NonFiniteMeasurementRunsTheFallback) {
 
 TEST(ControllerRobustness, NonFiniteFirstMeasurementLeavesTheControllerUninitialised) {
   const ControllerDesign design = ControllerDesign::create(testing::paperParameters());
-  RuntimeFollowerController controller(design);
+  DynamicFollowerController controller(design);
   const auto& status = controller.step(Eigen::Vector2d(kNaN, 0.0));
   EXPECT_TRUE(status.measurement_rejected);
   EXPECT_TRUE(status.fallback);
   EXPECT_TRUE(status.command.isZero());  // the fallback from the zero estimate
   // The first finite measurement initialises the estimate from itself, as without the NaN.
   controller.step(Eigen::Vector2d(2.0, 0.5));
-  RuntimeFollowerController fresh(design);
+  DynamicFollowerController fresh(design);
   fresh.step(Eigen::Vector2d(2.0, 0.5));
   EXPECT_MATRIX_NEAR(controller.estimate(), fresh.estimate(), 0.0);
   EXPECT_FALSE(controller.status().measurement_rejected);
@@ -105,19 +105,19 @@ TEST(ControllerRobustness, NonFiniteLeaderInputIsTakenAsUnknown) {
   p.leader_input_in_command = true;
   p.leader_input_in_estimator = true;
   const ControllerDesign design = ControllerDesign::create(p);
-  RuntimeFollowerController controller(design);
-  RuntimeFollowerController twin(design);
+  DynamicFollowerController controller(design);
+  DynamicFollowerController twin(design);
   const Eigen::Vector2d y(1.5, -0.3);
   const Eigen::VectorXd bad = Eigen::VectorXd::Constant(1, kNaN);
   for (int k = 0; k < 10; ++k) {
-    const RuntimeFollowerStatus& status = controller.step(y, bad);
-    const RuntimeFollowerStatus& expected = twin.step(y);
+    const DynamicFollowerStatus& status = controller.step(y, bad);
+    const DynamicFollowerStatus& expected = twin.step(y);
     EXPECT_TRUE(status.leader_input_rejected);
     EXPECT_FALSE(status.measurement_rejected);
     EXPECT_MATRIX_NEAR(status.command, expected.command, 0.0);
     EXPECT_MATRIX_NEAR(status.feedforward_command, Eigen::VectorXd::Zero(1), 0.0);
   }
-  const RuntimeFollowerStatus& status = controller.stepFallback(bad);
+  const DynamicFollowerStatus& status = controller.stepFallback(bad);
   EXPECT_TRUE(status.leader_input_rejected);
   EXPECT_MATRIX_NEAR(status.command, twin.stepFallback().command, 0.0);
   EXPECT_MATRIX_NEAR(controller.estimate(), twin.estimate(), 0.0);
@@ -239,7 +239,7 @@ TEST(ControllerRobustness, BoundHoldsInEveryNormEvaluation) {
   p.lyapunov_weight = Eigen::MatrixXd::Identity(6, 6);
   p.reference_gain = Eigen::MatrixXd::Zero(3, 6);
   const ControllerDesign design = ControllerDesign::create(p);
-  RuntimeFollowerController controller(design);
+  DynamicFollowerController controller(design);
   std::mt19937 rng(7);
   for (int k = 0; k < 3000; ++k) {
     const Eigen::VectorXd y = testing::randomVector(rng, 6, 5.0);

@@ -6,12 +6,12 @@
 
 #include <gtest/gtest.h>
 
-#include "projection_collision_avoidance/ControllerDesign.hpp"
-#include "projection_collision_avoidance/FollowerController.hpp"
-#include "projection_collision_avoidance/FollowerMode.hpp"
-#include "projection_collision_avoidance/ParameterError.hpp"
-#include "projection_collision_avoidance/RuntimeFollowerController.hpp"
-#include "projection_collision_avoidance/ScenarioLoader.hpp"
+#include "projection_collision_avoidance/core/ControllerDesign.hpp"
+#include "projection_collision_avoidance/core/FollowerController.hpp"
+#include "projection_collision_avoidance/core/FollowerMode.hpp"
+#include "projection_collision_avoidance/core/ParameterError.hpp"
+#include "projection_collision_avoidance/core/DynamicFollowerController.hpp"
+#include "projection_collision_avoidance/scenario/ScenarioLoader.hpp"
 
 #include "EigenTestHelpers.hpp"
 #include "TestScenarios.hpp"
@@ -133,7 +133,7 @@ TEST(FollowerFallback, NextMeasurementResumesTheLaws) {
 
 TEST(FollowerFallback, RuntimeControllerDispatches) {
   const ControllerDesign design = ControllerDesign::create(testing::paperParameters());
-  RuntimeFollowerController runtime(design);
+  DynamicFollowerController runtime(design);
   Controller1D fixed(design);
   const Eigen::Vector2d y(2.0, -0.5);
   runtime.step(y);

@@ -7,13 +7,13 @@
 #include <Eigen/Core>
 #include <gtest/gtest.h>
 
-#include "projection_collision_avoidance/AgentIntegrator.hpp"
-#include "projection_collision_avoidance/ClosedLoopSimulator.hpp"
-#include "projection_collision_avoidance/ContinuousClosedLoop.hpp"
-#include "projection_collision_avoidance/ControllerDesign.hpp"
-#include "projection_collision_avoidance/FollowerController.hpp"
-#include "projection_collision_avoidance/RuntimeFollowerController.hpp"
-#include "projection_collision_avoidance/ScenarioEmbedding.hpp"
+#include "projection_collision_avoidance/sim/AgentIntegrator.hpp"
+#include "projection_collision_avoidance/sim/SampledSimulator.hpp"
+#include "projection_collision_avoidance/sim/ContinuousDynamics.hpp"
+#include "projection_collision_avoidance/core/ControllerDesign.hpp"
+#include "projection_collision_avoidance/core/FollowerController.hpp"
+#include "projection_collision_avoidance/core/DynamicFollowerController.hpp"
+#include "projection_collision_avoidance/sim/ScenarioEmbedding.hpp"
 
 #include "AllocationCounter.hpp"
 #include "TestScenarios.hpp"
@@ -89,7 +89,7 @@ TEST(NoAllocation, ControlStepsOfFixedSizeControllers) {
 
 TEST(NoAllocation, ControlStepsOfTheRuntimeController) {
   for (const int axes : {1, 3}) {
-    RuntimeFollowerController controller(designFor(axes, true));
+    DynamicFollowerController controller(designFor(axes, true));
     Eigen::VectorXd y = Eigen::VectorXd::Constant(2 * axes, 0.2);
     const Eigen::VectorXd u1 = Eigen::VectorXd::Constant(axes, 0.3);
     controller.step(y);
@@ -125,7 +125,7 @@ TEST(NoAllocation, ControlStepsWithTheRateLimitActive) {
   EXPECT_GT(limited_3d, 100);
   EXPECT_GT(limited_generic, 100);
 
-  RuntimeFollowerController runtime(designFor(2, true, 5.0));
+  DynamicFollowerController runtime(designFor(2, true, 5.0));
   Eigen::VectorXd y = Eigen::VectorXd::Constant(4, 0.2);
   const Eigen::VectorXd u1 = Eigen::VectorXd::Constant(2, 0.3);
   runtime.step(y);
@@ -145,11 +145,11 @@ TEST(NoAllocation, ControlStepsWithTheRateLimitActive) {
 /// the evaluations whose command the limit scaled.
 template <typename Dims>
 long allocationsDuringEvaluations(const ControllerDesign& design, int evaluations, int* saturated) {
-  const ContinuousClosedLoop<Dims> loop(design);
+  const ContinuousDynamics<Dims> loop(design);
   const Eigen::Index n = design.parameters.model.stateDimension();
-  typename ContinuousClosedLoop<Dims>::State z;
-  typename ContinuousClosedLoop<Dims>::State derivative;
-  typename ContinuousClosedLoop<Dims>::Signals signals;
+  typename ContinuousDynamics<Dims>::State z;
+  typename ContinuousDynamics<Dims>::State derivative;
+  typename ContinuousDynamics<Dims>::Signals signals;
   z.follower = Dims::StateVector::Zero(n);
   z.estimate = Dims::StateVector::Constant(n, 0.1);
   const typename Dims::InputVector u1 =

@@ -2,9 +2,9 @@
 
 #include <gtest/gtest.h>
 
-#include "projection_collision_avoidance/ClosedLoopSimulator.hpp"
-#include "projection_collision_avoidance/ScenarioEmbedding.hpp"
-#include "projection_collision_avoidance/ScenarioLoader.hpp"
+#include "projection_collision_avoidance/sim/SampledSimulator.hpp"
+#include "projection_collision_avoidance/sim/ScenarioEmbedding.hpp"
+#include "projection_collision_avoidance/scenario/ScenarioLoader.hpp"
 
 #include "EigenTestHelpers.hpp"
 #include "TestScenarios.hpp"

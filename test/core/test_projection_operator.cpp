@@ -6,10 +6,10 @@
 
 #include <gtest/gtest.h>
 
-#include "projection_collision_avoidance/BallConstraint.hpp"
-#include "projection_collision_avoidance/CollisionFreeEstimator.hpp"
-#include "projection_collision_avoidance/ControllerDesign.hpp"
-#include "projection_collision_avoidance/ProjectionOperator.hpp"
+#include "projection_collision_avoidance/core/BallConstraint.hpp"
+#include "projection_collision_avoidance/core/CollisionFreeEstimator.hpp"
+#include "projection_collision_avoidance/core/ControllerDesign.hpp"
+#include "projection_collision_avoidance/core/ProjectionOperator.hpp"
 
 #include "EigenTestHelpers.hpp"
 #include "TestScenarios.hpp"

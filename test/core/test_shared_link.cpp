@@ -12,11 +12,11 @@
 #include <Eigen/Core>
 #include <gtest/gtest.h>
 
-#include "projection_collision_avoidance/CfSimApp.hpp"
-#include "projection_collision_avoidance/ClosedLoopSimulator.hpp"
-#include "projection_collision_avoidance/ParameterError.hpp"
-#include "projection_collision_avoidance/ScenarioLoader.hpp"
-#include "projection_collision_avoidance/SharedLink.hpp"
+#include "projection_collision_avoidance/scenario/CfSimApp.hpp"
+#include "projection_collision_avoidance/sim/SampledSimulator.hpp"
+#include "projection_collision_avoidance/core/ParameterError.hpp"
+#include "projection_collision_avoidance/scenario/ScenarioLoader.hpp"
+#include "projection_collision_avoidance/sim/SharedLink.hpp"
 
 #include "TestScenarios.hpp"
 

@@ -10,11 +10,11 @@
 #include <Eigen/Core>
 #include <gtest/gtest.h>
 
-#include "projection_collision_avoidance/ClosedLoopSimulator.hpp"
-#include "projection_collision_avoidance/ControllerDesign.hpp"
-#include "projection_collision_avoidance/PlatoonLaws.hpp"
-#include "projection_collision_avoidance/ScenarioLoader.hpp"
-#include "projection_collision_avoidance/StringStability.hpp"
+#include "projection_collision_avoidance/sim/SampledSimulator.hpp"
+#include "projection_collision_avoidance/core/ControllerDesign.hpp"
+#include "projection_collision_avoidance/core/PlatoonLaws.hpp"
+#include "projection_collision_avoidance/scenario/ScenarioLoader.hpp"
+#include "projection_collision_avoidance/sim/StringStability.hpp"
 
 #include "TestScenarios.hpp"
 

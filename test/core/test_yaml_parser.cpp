@@ -12,8 +12,8 @@
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
-#include "projection_collision_avoidance/ParameterError.hpp"
-#include "projection_collision_avoidance/ScenarioLoader.hpp"
+#include "projection_collision_avoidance/core/ParameterError.hpp"
+#include "projection_collision_avoidance/scenario/ScenarioLoader.hpp"
 
 #include "TestScenarios.hpp"
 #include "YamlParser.hpp"

@@ -1,5 +1,5 @@
 /// libFuzzer target on the core controller: a parameter set and a sequence of calls, both decoded
-/// from the input, drive RuntimeFollowerController (and, for some inputs, a
+/// from the input, drive DynamicFollowerController (and, for some inputs, a
 /// FollowerController<GenericDimensions> alongside). ControllerDesign::create() refusing the
 /// parameters (ParameterError) is a valid outcome; any other exception, a sanitizer report or a
 /// violated invariant aborts. After every call:
@@ -31,11 +31,11 @@
 #include <Eigen/Core>
 #include <Eigen/QR>
 
-#include "projection_collision_avoidance/BallConstraint.hpp"
-#include "projection_collision_avoidance/ControllerDesign.hpp"
-#include "projection_collision_avoidance/FollowerController.hpp"
-#include "projection_collision_avoidance/ParameterError.hpp"
-#include "projection_collision_avoidance/RuntimeFollowerController.hpp"
+#include "projection_collision_avoidance/core/BallConstraint.hpp"
+#include "projection_collision_avoidance/core/ControllerDesign.hpp"
+#include "projection_collision_avoidance/core/FollowerController.hpp"
+#include "projection_collision_avoidance/core/ParameterError.hpp"
+#include "projection_collision_avoidance/core/DynamicFollowerController.hpp"
 
 namespace pca = projection_collision_avoidance;
 
@@ -491,7 +491,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
                  q.leader_input_in_estimator, header.non_finite, header.shadow);
   }
 
-  pca::RuntimeFollowerController controller(*design);
+  pca::DynamicFollowerController controller(*design);
   std::optional<Shadow> shadow;
   if (header.shadow) {
     shadow.emplace(*design);

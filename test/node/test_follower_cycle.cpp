@@ -12,7 +12,7 @@
 
 #include <gtest/gtest.h>
 
-#include "projection_collision_avoidance/ControllerDesign.hpp"
+#include "projection_collision_avoidance/core/ControllerDesign.hpp"
 #include "projection_collision_avoidance/node/FollowerCycle.hpp"
 #include "projection_collision_avoidance/rt/Handoff.hpp"
 #include "projection_collision_avoidance/rt/LatestValue.hpp"
@@ -39,7 +39,7 @@ ControllerDesign run2Design(double time_headway = 0.0) {
 std::unique_ptr<FollowerCycle> makeCycle(FollowerCycleSettings settings = {},
                                          double time_headway = 0.0) {
   const ControllerDesign design = run2Design(time_headway);
-  return std::make_unique<FollowerCycle>(std::make_unique<RuntimeFollowerController>(design),
+  return std::make_unique<FollowerCycle>(std::make_unique<DynamicFollowerController>(design),
                                          design.parameters.separation, settings);
 }
 
@@ -113,8 +113,8 @@ TEST(FollowerCycle, TheControlThreadAllocatesAndFreesNothing) {
   // The control thread: ticks, a reconfiguration adopted half way, every output handed off.
   long allocations = -1;
   long frees = -1;
-  std::unique_ptr<RuntimeFollowerController> offered =
-      std::make_unique<RuntimeFollowerController>(run2Design(0.5));
+  std::unique_ptr<DynamicFollowerController> offered =
+      std::make_unique<DynamicFollowerController>(run2Design(0.5));
   std::thread control([&] {
     FollowerCycleOutput out;
     const long allocations_before = testing::threadAllocationCount();

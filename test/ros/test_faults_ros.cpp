@@ -23,7 +23,7 @@
 #include <ros/ros.h>
 #include <xmlrpcpp/XmlRpc.h>
 
-#include "projection_collision_avoidance/ControllerDesign.hpp"
+#include "projection_collision_avoidance/core/ControllerDesign.hpp"
 #include "projection_collision_avoidance/ros/MessageConversions.hpp"
 #include "projection_collision_avoidance/ros/RosParameters.hpp"
 

@@ -10,8 +10,8 @@
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 
-#include "projection_collision_avoidance/ClosedLoopSimulator.hpp"
-#include "projection_collision_avoidance/ControllerDesign.hpp"
+#include "projection_collision_avoidance/sim/SampledSimulator.hpp"
+#include "projection_collision_avoidance/core/ControllerDesign.hpp"
 #include "projection_collision_avoidance/ros/RosParameters.hpp"
 
 #include "test_common.h"

@@ -5,9 +5,9 @@
 #include <memory>
 #include <mutex>
 
-#include "projection_collision_avoidance/FollowerMode.hpp"
-#include "projection_collision_avoidance/RuntimeFollowerController.hpp"
-#include "projection_collision_avoidance/TypeDefs.hpp"
+#include "projection_collision_avoidance/core/FollowerMode.hpp"
+#include "projection_collision_avoidance/core/DynamicFollowerController.hpp"
+#include "projection_collision_avoidance/core/TypeDefs.hpp"
 #include "projection_collision_avoidance/rt/LatestValue.hpp"
 
 namespace projection_collision_avoidance {
@@ -65,7 +65,7 @@ struct FollowerCycleOutput {
   bool own_state_fresh = false;
   GenericDimensions::StateVector xi;  ///< x_target - x_i - d of the measurement used (m, m/s)
   double distance = 0.0;              ///< ||p_target - p_i|| of that measurement (m)
-  RuntimeFollowerStatus status;       ///< the controller's step
+  DynamicFollowerStatus status;       ///< the controller's step
   // The design in force (filled with or without a step).
   double xi_max = 0.0;              ///< (1 - alpha) ||d|| in force (m)
   double xi_soft = 0.0;             ///< xi_max / sqrt(1 + epsilon) in force (m)
@@ -86,7 +86,7 @@ struct FollowerCycleOutput {
 /// slots the input side writes (measurement(), leader(), ownState()), decides the mode from their
 /// ages, runs one step of the controller and fills a FollowerCycleOutput. With a time headway
 /// (time_headway > 0) a step with a measurement uses the own state while it is younger than the
-/// measurement timeout (RuntimeFollowerController::stepWithOwnState()), else leaves the headway
+/// measurement timeout (DynamicFollowerController::stepWithOwnState()), else leaves the headway
 /// out. Nothing in tick() or stepOnMeasurement() allocates, locks (except under the measurement
 /// trigger, whose steps run in the measurement's callback, and a tick waits for a step running
 /// there) or makes a system call, so that a real-time thread can run it.
@@ -100,7 +100,7 @@ class FollowerCycle {
  public:
   /// @param controller the controller, moved in
   /// @param separation d of this follower's slot (n entries)
-  FollowerCycle(std::unique_ptr<RuntimeFollowerController> controller,
+  FollowerCycle(std::unique_ptr<DynamicFollowerController> controller,
                 const Eigen::VectorXd& separation, FollowerCycleSettings settings);
   ~FollowerCycle();
   FollowerCycle(const FollowerCycle&) = delete;
@@ -127,10 +127,10 @@ class FollowerCycle {
   /// coming tick adopts it, carrying over the estimate and previous command, once the controller
   /// it replaced last time has been collected with retired(). A controller offered before and
   /// not yet adopted is returned for disposal.
-  std::unique_ptr<RuntimeFollowerController> offer(
-      std::unique_ptr<RuntimeFollowerController> controller);
+  std::unique_ptr<DynamicFollowerController> offer(
+      std::unique_ptr<DynamicFollowerController> controller);
   /// The controller replaced by the last adoption, for disposal off the control thread.
-  std::unique_ptr<RuntimeFollowerController> retired();
+  std::unique_ptr<DynamicFollowerController> retired();
 
   /// Design in force at the last tick (read it from the control thread only, or before start).
   const ControllerDesign& design() const { return controller_->design(); }
@@ -143,9 +143,9 @@ class FollowerCycle {
   /// The counters and the design in force into @p out (whether or not a step ran).
   void fillCounters(std::int64_t now_ns, FollowerCycleOutput* out) const;
 
-  std::unique_ptr<RuntimeFollowerController> controller_;
-  std::atomic<RuntimeFollowerController*> offered_{nullptr};
-  std::atomic<RuntimeFollowerController*> retired_{nullptr};
+  std::unique_ptr<DynamicFollowerController> controller_;
+  std::atomic<DynamicFollowerController*> offered_{nullptr};
+  std::atomic<DynamicFollowerController*> retired_{nullptr};
   GenericDimensions::StateVector separation_;
   FollowerCycleSettings settings_;
   double period_ = 0.0;

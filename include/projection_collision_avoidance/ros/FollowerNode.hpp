@@ -13,7 +13,7 @@ class FollowerOutputs;
 class FollowerReconfigure;
 struct Scenario;
 
-/// ROS wrapper of RuntimeFollowerController: translates messages and time, nothing else.
+/// ROS wrapper of DynamicFollowerController: translates messages and time, nothing else.
 ///
 /// The follower is member ~formation_index of the scenario's formation (layoutFormation()): it
 /// keeps the separation d_i of its slot to its target (the leader, or the follower ahead of it in

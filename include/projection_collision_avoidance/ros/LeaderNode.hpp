@@ -7,7 +7,7 @@
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
 
-#include "projection_collision_avoidance/Scenario.hpp"
+#include "projection_collision_avoidance/sim/Scenario.hpp"
 #include "projection_collision_avoidance/ros/InputAdmission.hpp"
 #include "projection_collision_avoidance/ros/InputGuard.hpp"
 

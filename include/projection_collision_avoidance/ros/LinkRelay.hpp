@@ -9,7 +9,7 @@
 #include <ros/ros.h>
 
 #include "projection_collision_avoidance/LeaderBroadcast.h"
-#include "projection_collision_avoidance/SharedLink.hpp"
+#include "projection_collision_avoidance/sim/SharedLink.hpp"
 #include "projection_collision_avoidance/ros/InputAdmission.hpp"
 
 namespace projection_collision_avoidance {

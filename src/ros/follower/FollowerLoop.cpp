@@ -7,7 +7,7 @@
 #include <string>
 #include <utility>
 
-#include "projection_collision_avoidance/ParameterError.hpp"
+#include "projection_collision_avoidance/core/ParameterError.hpp"
 #include "projection_collision_avoidance/ros/InputAdmission.hpp"
 
 namespace projection_collision_avoidance {

@@ -9,7 +9,7 @@
 
 #include "projection_collision_avoidance/node/FollowerCycle.hpp"
 #include "projection_collision_avoidance/ros/InputAdmission.hpp"
-#include "projection_collision_avoidance/ros/RealtimeLoop.hpp"
+#include "projection_collision_avoidance/rt/RealtimeLoop.hpp"
 
 #include "follower/FollowerOptions.hpp"
 #include "follower/FollowerOutputs.hpp"

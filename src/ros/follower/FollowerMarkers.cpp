@@ -12,7 +12,7 @@ namespace projection_collision_avoidance {
 
 void FollowerOutputs::publishMarkers(const FollowerCycleOutput& out) {
   using visualization_msgs::Marker;
-  const RuntimeFollowerStatus& s = out.status;
+  const DynamicFollowerStatus& s = out.status;
   const std::string& frame = options_.follower_frame;
   const ros::Time now = rosTimeOf(out.stamp_ns);
   const Eigen::Index axes = separation_.size() / 2;

@@ -3,9 +3,9 @@
 #include <cstdint>
 #include <string>
 
-#include "projection_collision_avoidance/ControllerParameters.hpp"
-#include "projection_collision_avoidance/Formation.hpp"
-#include "projection_collision_avoidance/Scenario.hpp"
+#include "projection_collision_avoidance/core/ControllerParameters.hpp"
+#include "projection_collision_avoidance/core/Formation.hpp"
+#include "projection_collision_avoidance/sim/Scenario.hpp"
 #include "projection_collision_avoidance/ros/RosParameters.hpp"
 
 namespace projection_collision_avoidance {

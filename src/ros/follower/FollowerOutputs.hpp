@@ -11,7 +11,7 @@
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <ros/ros.h>
 
-#include "projection_collision_avoidance/Formation.hpp"
+#include "projection_collision_avoidance/core/Formation.hpp"
 #include "projection_collision_avoidance/node/FollowerCycle.hpp"
 #include "projection_collision_avoidance/rt/Handoff.hpp"
 

@@ -3,9 +3,9 @@
 #include <cmath>
 #include <utility>
 
-#include "projection_collision_avoidance/ControllerDesign.hpp"
-#include "projection_collision_avoidance/ParameterError.hpp"
-#include "projection_collision_avoidance/RuntimeFollowerController.hpp"
+#include "projection_collision_avoidance/core/ControllerDesign.hpp"
+#include "projection_collision_avoidance/core/ParameterError.hpp"
+#include "projection_collision_avoidance/core/DynamicFollowerController.hpp"
 #include "projection_collision_avoidance/ros/RosParameters.hpp"
 
 namespace projection_collision_avoidance {
@@ -75,7 +75,7 @@ void FollowerReconfigure::onReconfigure(FollowerConfig& config, uint32_t /*level
       candidate.tracker_gain = file_parameters_.tracker_gain;  // 0: the scenario file's gain
     }
     auto controller =
-        std::make_unique<RuntimeFollowerController>(ControllerDesign::create(candidate));
+        std::make_unique<DynamicFollowerController>(ControllerDesign::create(candidate));
     const double xi_max = controller->design().xi_max;
     cycle_->offer(std::move(controller)).reset();  // an offer not yet adopted is superseded
     parameters_ = candidate;

@@ -7,7 +7,7 @@ namespace projection_collision_avoidance {
 
 FollowerStatus toStatusMsg(const FollowerCycleOutput& out, const FollowerInputStats& inputs,
                            const FormationMember& member, const std::string& frame) {
-  const RuntimeFollowerStatus& s = out.status;
+  const DynamicFollowerStatus& s = out.status;
   FollowerStatus msg;
   msg.header.stamp = rosTimeOf(out.stamp_ns);
   msg.header.frame_id = frame;

@@ -3,7 +3,7 @@
 #include <string>
 
 #include "projection_collision_avoidance/FollowerStatus.h"
-#include "projection_collision_avoidance/Formation.hpp"
+#include "projection_collision_avoidance/core/Formation.hpp"
 #include "projection_collision_avoidance/node/FollowerCycle.hpp"
 
 #include "follower/FollowerInputs.hpp"

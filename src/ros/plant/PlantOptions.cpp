@@ -3,7 +3,7 @@
 #include <limits>
 #include <string>
 
-#include "projection_collision_avoidance/ParameterError.hpp"
+#include "projection_collision_avoidance/core/ParameterError.hpp"
 
 namespace projection_collision_avoidance {
 namespace {

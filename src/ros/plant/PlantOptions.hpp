@@ -2,7 +2,7 @@
 
 #include <string>
 
-#include "projection_collision_avoidance/Scenario.hpp"
+#include "projection_collision_avoidance/sim/Scenario.hpp"
 #include "projection_collision_avoidance/ros/RosParameters.hpp"
 #include "projection_collision_avoidance/sim/MeasurementChannel.hpp"
 

@@ -13,8 +13,8 @@
 #include <tf2_eigen/tf2_eigen.h>
 #include <visualization_msgs/MarkerArray.h>
 
-#include "projection_collision_avoidance/Formation.hpp"
-#include "projection_collision_avoidance/ParameterError.hpp"
+#include "projection_collision_avoidance/core/Formation.hpp"
+#include "projection_collision_avoidance/core/ParameterError.hpp"
 #include "projection_collision_avoidance/ros/MessageConversions.hpp"
 #include "projection_collision_avoidance/ros/PlantNode.hpp"
 

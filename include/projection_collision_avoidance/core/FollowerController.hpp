@@ -1,0 +1,327 @@
+#pragma once
+
+#include "projection_collision_avoidance/core/BallConstraint.hpp"
+#include "projection_collision_avoidance/core/CollisionFreeEstimator.hpp"
+#include "projection_collision_avoidance/core/CollisionFreeTracker.hpp"
+#include "projection_collision_avoidance/core/CommandRateLimiter.hpp"
+#include "projection_collision_avoidance/core/ControllerDesign.hpp"
+#include "projection_collision_avoidance/core/FollowerControllerStatus.hpp"
+#include "projection_collision_avoidance/core/PaperLaws.hpp"
+#include "projection_collision_avoidance/core/PlatoonLaws.hpp"
+#include "projection_collision_avoidance/core/TypeDefs.hpp"
+
+namespace projection_collision_avoidance {
+
+/// The follower's controller: baseline law (2) augmented (10) by the CF tracker (19), which
+/// tracks the CF estimator (11)-(15). One step() per control period T.
+///
+/// At a tick with measurement y = C xi the command is
+///   u_2 = rate(sat(G y + u_a + u_ff [+ K_h x_2])),   u_a = G_e (y - C xi_hat) + S_21 C xi_hat,
+/// computed from the current estimate (K_h x_2 the time headway (S1), given the own state x_2;
+/// u_ff the shared acceleration, shaped by (S2)), where sat() scales a vector longer than
+/// acceleration_limit onto it and rate() moves it to within jerk_limit T of the previous tick's
+/// command (CommandRateLimiter; zero before the first tick). The estimate is then integrated
+/// over [t, t + T] with y held and the augmentation that actually acts, u_2 - G y - u_ff (u_a
+/// [+ K_h x_2] when neither limit acted), so that its model of xi' stays that of the plant. Without
+/// a measurement stepFallback() brakes relative to the leader from the predicted estimate instead,
+/// under the same two limits, so that a change of mode cannot jump the command. A step allocates
+/// no memory.
+///
+/// Whatever the inputs, after every call the command is finite with euclideanNorm(u_2) <=
+/// acceleration_limit and euclideanNorm(u_2 - u_2 of the previous call) <= jerk_limit T, and
+/// the estimate is finite with euclideanNorm(xi_hat) <= xi_max: a
+/// non-finite measurement is treated as missing, a non-finite u_1 as unknown, a command that
+/// overflows is replaced by a finite one, and an estimator substep that overflows is discarded;
+/// each is flagged in the status.
+template <typename Dims>
+class FollowerController {
+ public:
+  using StateVector = typename Dims::StateVector;
+  using InputVector = typename Dims::InputVector;
+  using OutputVector = typename Dims::OutputVector;
+
+  /// @param design validated parameters; their sizes must match Dims (std::invalid_argument)
+  explicit FollowerController(const ControllerDesign& design)
+      : design_(design),
+        estimator_(design),
+        tracker_(design),
+        input_matrix_(design.parameters.model.B),
+        output_matrix_(design.parameters.model.C),
+        baseline_gain_(design.parameters.baseline_gain),
+        output_pseudoinverse_(design.output_pseudoinverse),
+        fallback_gain_(design.fallback_gain),
+        headway_gain_(design.headway_gain),
+        feedforward_filter_(design.parameters.feedforward_gain, design.feedforward_smoothing,
+                            design.parameters.model.inputDimension()),
+        headway_(design.parameters.time_headway > 0.0),
+        rate_limiter_(design.parameters.jerk_limit, design.period,
+                      design.parameters.acceleration_limit,
+                      design.parameters.model.inputDimension()) {
+    status_.command = InputVector::Zero(design.parameters.model.inputDimension());
+    status_.baseline_command = status_.command;
+    status_.tracker_command = status_.command;
+    status_.feedforward_command = status_.command;
+    status_.headway_command = status_.command;
+    status_.fallback_command = status_.command;
+    status_.estimate = estimator_.estimate();
+  }
+
+  /// One control period without leader information (u_1 taken as unknown).
+  ///
+  /// A measurement with a non-finite entry (NaN, +-inf) does not reach the laws or the
+  /// estimator: it counts as missing, the tick runs the fallback exactly as stepFallback() does,
+  /// and status.measurement_rejected (with status.fallback) says so. A finite measurement so
+  /// large that the laws' command G y + u_a + u_ff overflows runs the fallback as well, flagged
+  /// status.command_overflow. So the command is always finite with ||u_2|| <=
+  /// acceleration_limit (in euclideanNorm()), and the estimate finite with ||xi_hat|| <= xi_max.
+  /// @param y relative measurement C (x_1 - x_2 - d)
+  /// @return the status of this tick; status.command is u_2 (m/s^2 for double integrators)
+  const FollowerControllerStatus<Dims>& step(const OutputVector& y) {
+    return tick(&y, InputVector::Zero(input_matrix_.cols()), false);
+  }
+
+  /// One control period with the leader's current input u_1 (used as configured by
+  /// leader_input_in_command / leader_input_in_estimator). A u_1 with a non-finite entry is
+  /// taken as unknown for this tick (status.leader_input_rejected), as in step(y); a non-finite
+  /// y is handled as in step(y).
+  const FollowerControllerStatus<Dims>& step(const OutputVector& y,
+                                             const InputVector& leader_input) {
+    return tick(&y, leader_input, true);
+  }
+
+  /// step(y) with the follower's own state x_2, from which the time headway (S1) acts (when
+  /// time_headway > 0; a non-finite x_2 leaves it out for this tick, and so does step()).
+  const FollowerControllerStatus<Dims>& stepWithOwnState(const OutputVector& y,
+                                                         const StateVector& own_state) {
+    return tick(&y, InputVector::Zero(input_matrix_.cols()), false, &own_state);
+  }
+
+  /// step(y, leader_input) with the follower's own state x_2, as stepWithOwnState(y, x_2).
+  const FollowerControllerStatus<Dims>& stepWithOwnState(const OutputVector& y,
+                                                         const StateVector& own_state,
+                                                         const InputVector& leader_input) {
+    return tick(&y, leader_input, true, &own_state);
+  }
+
+  /// One control period without a measurement: the fallback. The command brakes relative to
+  /// the leader from the estimate, which is predicted by the model alone and stays in Omega_1:
+  ///   u_2 = rate(sat(u_ff + K_f xi_hat)),   xi_hat' = Proj(A xi_hat + B (u_1m - u_2)),
+  /// with u_ff and u_1m the leader input as shared into the command and the estimator (0 when
+  /// unknown). For the default K_f = [0, k_v I] of a double integrator the predicted relative
+  /// velocity decays as e^{-k_v t} and the relative position comes to rest. Before any
+  /// measurement the estimate is the one the next step() would replace, zero. If u_ff + K_f
+  /// xi_hat overflows (huge gains), the command is u_ff alone, saturated and rate limited
+  /// (command_overflow).
+  const FollowerControllerStatus<Dims>& stepFallback() {
+    return tick(nullptr, InputVector::Zero(input_matrix_.cols()), false);
+  }
+
+  /// The fallback with the leader's current input u_1 (see stepFallback()); a u_1 with a
+  /// non-finite entry is taken as unknown (status.leader_input_rejected).
+  const FollowerControllerStatus<Dims>& stepFallback(const InputVector& leader_input) {
+    return tick(nullptr, leader_input, true);
+  }
+
+  /// Forgets the estimate and the previous command (back to zero, a vehicle at rest); the next
+  /// step initialises the estimate as configured.
+  void reset() {
+    initialized_ = false;
+    rate_limiter_.reset();
+    feedforward_filter_.reset();
+  }
+
+  /// Sets the estimate (projected into Omega_1; zero if not finite) and marks the controller
+  /// initialised. The previous command is kept.
+  void resetEstimate(const StateVector& estimate) {
+    estimator_.reset(estimate);
+    initialized_ = true;
+  }
+
+  /// False until the first step (or resetEstimate()) has set the estimate.
+  bool initialized() const { return initialized_; }
+
+  /// The estimate that the next step will use (m).
+  const StateVector& estimate() const { return estimator_.estimate(); }
+
+  /// The command of the last step, from which the next one may change by at most jerk_limit T
+  /// (m/s^2 for double integrators); zero before the first step and after reset().
+  const InputVector& previousCommand() const { return rate_limiter_.previous(); }
+
+  /// Sets the previous command (moved into ||u|| <= acceleration_limit; zero if not finite), for
+  /// example to carry it over to a controller with a new design.
+  void setPreviousCommand(const InputVector& command) { rate_limiter_.setPrevious(command); }
+
+  const FollowerControllerStatus<Dims>& status() const { return status_; }
+  const ControllerDesign& design() const { return design_; }
+  const CollisionFreeEstimator<Dims>& estimator() const { return estimator_; }
+
+ private:
+  /// One tick: checks the inputs, then runs the laws (y given and finite) or the fallback.
+  const FollowerControllerStatus<Dims>& tick(const OutputVector* y, const InputVector& leader_input,
+                                             bool leader_input_known,
+                                             const StateVector* own_state = nullptr) {
+    status_.measurement_rejected = false;
+    status_.leader_input_rejected = false;
+    status_.command_overflow = false;
+    status_.estimate_held = false;
+    if (leader_input_known && !leader_input.allFinite()) {
+      status_.leader_input_rejected = true;
+      leader_input_known = false;
+    }
+    if (y != nullptr && !y->allFinite()) {
+      status_.measurement_rejected = true;
+      y = nullptr;
+    }
+    setFeedforward(leader_input, leader_input_known);
+    if (y != nullptr && advance(*y, leader_input, leader_input_known, own_state)) {
+      return status_;
+    }
+    return fallback(leader_input, leader_input_known);
+  }
+
+  /// Initialises the estimate from the finite y as configured.
+  void initialize(const OutputVector& y) {
+    if (design_.parameters.initial_estimate == InitialEstimate::kZero) {
+      estimator_.reset(StateVector::Zero(input_matrix_.rows()));
+    } else {
+      const StateVector initial = output_pseudoinverse_ * y;
+      if (initial.allFinite()) {
+        estimator_.reset(initial);
+      } else {  // pinv(C) y overflows: keep its direction, scaled
+        const double scale = y.cwiseAbs().maxCoeff();
+        estimator_.reset(output_pseudoinverse_ * (y / scale), scale);
+      }
+    }
+    initialized_ = true;
+  }
+
+  /// The laws for the finite y; false, with nothing changed but the initialisation and
+  /// command_overflow set, if their command is not finite.
+  bool advance(const OutputVector& y, const InputVector& leader_input, bool leader_input_known,
+               const StateVector* own_state) {
+    const ControllerParameters& p = design_.parameters;
+    if (!initialized_) {
+      initialize(y);
+    }
+    const StateVector& estimate = estimator_.estimate();
+    const OutputVector estimated_output = output_matrix_ * estimate;
+
+    status_.baseline_command = baselineCommand<Dims>(baseline_gain_, y);  // (2)
+    status_.tracker_command = tracker_.command(y, estimated_output);      // (19)
+    const bool headway = headway_ && own_state != nullptr && own_state->allFinite();
+    status_.headway_command.setZero();
+    if (headway) {  // (S1)
+      status_.headway_command = headway_gain_ * (*own_state);
+    }
+    status_.command_saturated = augmentedCommand<Dims>(  // (10); an overflow stays not finite
+        status_.baseline_command, status_.tracker_command, status_.feedforward_command,
+        headway ? &status_.headway_command : nullptr, p.acceleration_limit, &status_.command);
+    if (!status_.command.allFinite()) {
+      status_.command_overflow = true;
+      return false;
+    }
+    status_.estimate = estimate;
+    status_.estimate_norm = euclideanNorm(estimate);
+    status_.constraint_value = estimator_.constraint().value(estimate);
+    status_.fallback_command.setZero();
+    status_.fallback = false;
+    status_.command_rate_limited = rate_limiter_.limit(status_.command);
+    InputVector acting_augmentation = status_.tracker_command;  // u_a [+ K_h x_2], unless cut
+    if (status_.command_saturated || status_.command_rate_limited) {
+      acting_augmentation = actingAugmentation(status_.command, status_.baseline_command,
+                                               status_.feedforward_command);
+    } else if (headway) {
+      acting_augmentation += status_.headway_command;
+    }
+
+    const StateVector known_drift = knownDrift(leader_input, leader_input_known);
+    const EstimatorPeriodReport report = estimator_.advance(y, acting_augmentation, known_drift,
+                                                            design_.period, p.estimator_substeps);
+    status_.projection_active = report.projection_active;
+    status_.boundary_correction = report.boundary_correction;
+    status_.estimate_held = report.estimate_held;
+    return true;
+  }
+
+  const FollowerControllerStatus<Dims>& fallback(const InputVector& leader_input,
+                                                 bool leader_input_known) {
+    const ControllerParameters& p = design_.parameters;
+    const StateVector& estimate = estimator_.estimate();
+    status_.estimate = estimate;
+    status_.estimate_norm = euclideanNorm(estimate);
+    status_.constraint_value = estimator_.constraint().value(estimate);
+    status_.baseline_command.setZero();
+    status_.tracker_command.setZero();
+    status_.headway_command.setZero();
+    status_.fallback = true;
+    status_.fallback_command = fallback_gain_ * estimate;
+    status_.command = status_.feedforward_command + status_.fallback_command;
+    if (!status_.command.allFinite()) {  // K_f xi_hat overflows: u_ff alone (finite)
+      status_.command_overflow = true;
+      status_.fallback_command.setZero();
+      status_.command = status_.feedforward_command;
+    }
+    limitCommand();
+
+    // xi' = A xi + B (u_1 - u_ff) - B (u_2 - u_ff), with u_1 - u_ff modelled as in step().
+    const StateVector drift = knownDrift(leader_input, leader_input_known) -
+                              input_matrix_ * (status_.command - status_.feedforward_command);
+    const EstimatorPeriodReport report =
+        estimator_.predict(drift, design_.period, p.estimator_substeps);
+    status_.projection_active = report.projection_active;
+    status_.boundary_correction = report.boundary_correction;
+    status_.estimate_held = report.estimate_held;
+    return status_;
+  }
+
+  /// w = B (u_1 - u_ff) when the leader's input is shared into the estimator, else 0 (m/s).
+  StateVector knownDrift(const InputVector& leader_input, bool leader_input_known) const {
+    if (leader_input_known && design_.parameters.leader_input_in_estimator) {
+      return leaderInputDrift<Dims>(input_matrix_, leader_input, status_.feedforward_command);
+    }
+    return StateVector::Zero(input_matrix_.rows());
+  }
+
+  /// u_ff of this tick: the shared acceleration, shaped by (S2) when configured; 0 (and the
+  /// filter restarted) when it is unknown or not shared into the command.
+  void setFeedforward(const InputVector& leader_input, bool leader_input_known) {
+    status_.feedforward_command.setZero();
+    if (leader_input_known && design_.parameters.leader_input_in_command) {
+      status_.feedforward_command =
+          feedforward_filter_.shapes() ? feedforward_filter_.apply(leader_input) : leader_input;
+    } else {
+      feedforward_filter_.reset();
+    }
+  }
+
+  /// The fallback's limits: sat() of (10) (saturateCommand(): euclideanNorm(command) <=
+  /// acceleration_limit exactly, no overflow), then the change from the previous tick's command
+  /// limited to jerk_limit T, inside the same ball.
+  void limitCommand() {
+    status_.command_saturated =
+        saturateCommand(&status_.command, design_.parameters.acceleration_limit);
+    status_.command_rate_limited = rate_limiter_.limit(status_.command);
+  }
+
+  ControllerDesign design_;
+  CollisionFreeEstimator<Dims> estimator_;
+  CollisionFreeTracker<Dims> tracker_;
+  typename Dims::InputMatrix input_matrix_;                 // B
+  typename Dims::OutputMatrix output_matrix_;               // C
+  typename Dims::FeedbackGainMatrix baseline_gain_;         // G
+  typename Dims::ObserverGainMatrix output_pseudoinverse_;  // pinv(C)
+  typename Dims::StateGainMatrix fallback_gain_;            // K_f
+  typename Dims::StateGainMatrix headway_gain_;             // K_h (S1)
+  FeedforwardFilter<InputVector> feedforward_filter_;       // (S2)
+  bool headway_;                                            // time_headway > 0
+  CommandRateLimiter<InputVector> rate_limiter_;            // jerk_limit, from u_2(k-1)
+  FollowerControllerStatus<Dims> status_;
+  bool initialized_ = false;
+};
+
+extern template class FollowerController<DoubleIntegrator1D>;
+extern template class FollowerController<DoubleIntegrator2D>;
+extern template class FollowerController<DoubleIntegrator3D>;
+extern template class FollowerController<GenericDimensions>;
+
+}  // namespace projection_collision_avoidance

@@ -1,0 +1,30 @@
+#pragma once
+
+#include <ostream>
+
+#include "projection_collision_avoidance/sim/SampledSimulator.hpp"
+#include "projection_collision_avoidance/sim/Scenario.hpp"
+
+namespace projection_collision_avoidance {
+
+/// Writes a run as CSV: a header row on construction, then one row per control tick with the
+/// columns of README.md, "Scenario files" (t, xi_*, xi_hat_*, norms, bounds, f, projection_active,
+/// positions, velocities for double integrators, separation, perimeter, u_*, u_baseline_*,
+/// u_tracker_*, leader_u_*, ud_*).
+class SimulationCsvWriter {
+ public:
+  SimulationCsvWriter(std::ostream& out, const Scenario& scenario);
+  void write(const SimulationSample& sample);
+
+ private:
+  std::ostream& out_;
+  int states_;
+  int inputs_;
+  int positions_;
+  bool velocities_;
+  double xi_max_;
+  double xi_soft_;
+  double perimeter_;
+};
+
+}  // namespace projection_collision_avoidance

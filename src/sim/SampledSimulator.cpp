@@ -1,0 +1,228 @@
+#include "projection_collision_avoidance/sim/SampledSimulator.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <limits>
+#include <locale>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "projection_collision_avoidance/sim/AgentIntegrator.hpp"
+#include "projection_collision_avoidance/core/ControllerDesign.hpp"
+#include "projection_collision_avoidance/core/DimensionDispatch.hpp"
+#include "projection_collision_avoidance/core/FollowerController.hpp"
+#include "projection_collision_avoidance/core/PaperLaws.hpp"
+#include "projection_collision_avoidance/core/ParameterError.hpp"
+#include "projection_collision_avoidance/sim/SharedLink.hpp"
+
+namespace projection_collision_avoidance {
+namespace {
+
+/// ||p_a - p_b||^2 over the first k (position) entries.
+template <typename Vector>
+double squaredPositionDistance(const Vector& a, const Vector& b, int k) {
+  double squared = 0.0;
+  for (int i = 0; i < k; ++i) {
+    const double delta = a(i) - b(i);
+    squared += delta * delta;
+  }
+  return squared;
+}
+
+/// ||p_a - p_b|| over the first k (position) entries.
+template <typename Vector>
+double positionDistance(const Vector& a, const Vector& b, int k) {
+  return std::sqrt(squaredPositionDistance(a, b, k));
+}
+
+/// One follower of the run: its controller, its plant and its figures.
+template <typename Dims>
+struct SimulatedFollower {
+  SimulatedFollower(const FormationMember& formation_member, const ControllerDesign& member_design,
+                    const AgentModel& model)
+      : member(formation_member),
+        design(member_design),
+        controller(member_design),
+        plant(model, member_design.period, formation_member.initial_state),
+        separation(formation_member.separation),
+        command(Dims::InputVector::Zero(model.inputDimension())) {
+    summary.xi_max = design.xi_max;
+    summary.perimeter = design.perimeter;
+    summary.min_separation = std::numeric_limits<double>::infinity();
+  }
+
+  FormationMember member;
+  ControllerDesign design;
+  FollowerController<Dims> controller;
+  AgentIntegrator<Dims> plant;
+  typename Dims::StateVector separation;  // d_i
+  typename Dims::InputVector command;     // u_i at the current tick
+  SimulationSummary summary;
+};
+
+template <typename Dims>
+FormationSummary runFormation(const Scenario& scenario, const ControllerDesign& scenario_design,
+                              const FormationObserver& observer) {
+  using StateVector = typename Dims::StateVector;
+  using InputVector = typename Dims::InputVector;
+  using OutputVector = typename Dims::OutputVector;
+  const ControllerParameters& p = scenario_design.parameters;
+  const AgentModel& model = p.model;
+  const Eigen::Index m = model.inputDimension();
+  const Eigen::Index n = model.stateDimension();
+  const int k = model.position_dimension;
+  const bool share_leader_input = p.leader_input_in_command || p.leader_input_in_estimator;
+  const typename Dims::OutputMatrix output_matrix = model.C;
+
+  const std::vector<FormationMember> members =
+      layoutFormation(scenario.formation, p.separation, scenario.leader_initial_state,
+                      scenario.follower_initial_state);
+  const int n_agents = static_cast<int>(members.size()) + 1;
+  std::vector<SimulatedFollower<Dims>> followers;
+  followers.reserve(members.size());
+  for (const FormationMember& member : members) {
+    followers.emplace_back(member, ControllerDesign::create(memberParameters(p, member)), model);
+  }
+  AgentIntegrator<Dims> leader(model, scenario_design.period, scenario.leader_initial_state,
+                               scenario.disturbance);
+  const StateVector zero_disturbance = StateVector::Zero(n);
+  const bool share_disturbance = share_leader_input && p.leader_disturbance_shared;
+  const bool need_disturbance = share_disturbance || static_cast<bool>(observer);
+  const typename Dims::StateGainMatrix input_pseudoinverse = scenario_design.input_pseudoinverse;
+  // The link of the shared accelerations (L1)-(L3): agent 0 the leader, i follower i. Without a
+  // link section a follower gets its target's acceleration of the same tick.
+  const bool use_link = share_leader_input && scenario.link.configured;
+  SharedLink<InputVector> link(scenario.link, p.control_rate, use_link ? n_agents : 0,
+                               use_link ? n_agents : 0, InputVector::Zero(m));
+
+  FormationSummary formation;
+  double min_pair_squared = std::numeric_limits<double>::infinity();
+  const long last_tick = std::lround(scenario.duration * p.control_rate);
+  for (long tick = 0; tick <= last_tick; ++tick) {
+    const double t = static_cast<double>(tick) / p.control_rate;
+    InputVector leader_input = InputVector::Zero(m);
+    scenario.leader_input.addTo(t, leader_input);
+    StateVector disturbance = zero_disturbance;
+    if (need_disturbance) {
+      scenario.disturbance.addTo(t, disturbance);
+    }
+    const InputVector leader_acceleration =  // a_1 = u_1 (+ pinv(B) u_d)
+        share_disturbance ? leaderAcceleration(leader_input, input_pseudoinverse, disturbance)
+                          : leader_input;
+    if (use_link) {
+      link.send(0, tick, leader_acceleration);
+    }
+    for (SimulatedFollower<Dims>& follower : followers) {
+      const bool behind_leader = follower.member.target == 0;
+      const SimulatedFollower<Dims>* ahead =
+          behind_leader ? nullptr
+                        : &followers[static_cast<std::size_t>(follower.member.target - 1)];
+      const StateVector& target_state = behind_leader ? leader.state() : ahead->plant.state();
+      const InputVector& target_acceleration =
+          use_link ? link.receive(follower.member.index, follower.member.target, tick)
+                   : (behind_leader ? leader_acceleration : ahead->command);
+      const StateVector xi = target_state - follower.plant.state() - follower.separation;
+      const OutputVector y = output_matrix * xi;
+      const StateVector& own_state = follower.plant.state();
+      const auto& status = share_leader_input ? follower.controller.stepWithOwnState(
+                                                    y, own_state, target_acceleration)
+                                              : follower.controller.stepWithOwnState(y, own_state);
+      follower.command = status.command;
+      if (use_link) {
+        link.send(follower.member.index, tick, follower.command);
+      }
+
+      SimulationSummary& summary = follower.summary;
+      const double xi_norm = xi.norm();
+      const double separation = positionDistance(target_state, follower.plant.state(), k);
+      summary.max_xi = std::max(summary.max_xi, xi_norm);
+      summary.max_xi_hat = std::max(summary.max_xi_hat, status.estimate_norm);
+      summary.min_separation = std::min(summary.min_separation, separation);
+      summary.max_boundary_correction =
+          std::max(summary.max_boundary_correction, status.boundary_correction);
+      if (xi_norm > follower.design.xi_max) {
+        summary.time_outside += follower.design.period;
+      }
+      ++summary.ticks;
+
+      if (observer) {
+        SimulationSample sample;
+        sample.time = t;
+        sample.relative_error = xi;
+        sample.estimate = status.estimate;
+        sample.constraint_value = status.constraint_value;
+        sample.projection_active = status.projection_active;
+        sample.leader_state = target_state;
+        sample.follower_state = follower.plant.state();
+        sample.separation = separation;
+        sample.command = status.command;
+        sample.baseline_command = status.baseline_command;
+        sample.tracker_command = status.tracker_command;
+        sample.leader_input = behind_leader ? leader_input : ahead->command;
+        sample.disturbance = behind_leader ? disturbance : zero_disturbance;
+        observer(follower.member.index - 1, sample);
+      }
+    }
+    // Squared distances, one square root at the end: sqrt is monotonic and correctly rounded,
+    // so the minimum is the same double.
+    for (std::size_t a = 0; a < followers.size(); ++a) {
+      const StateVector& x_a = followers[a].plant.state();
+      min_pair_squared =
+          std::min(min_pair_squared, squaredPositionDistance(x_a, leader.state(), k));
+      for (std::size_t b = a + 1; b < followers.size(); ++b) {
+        min_pair_squared =
+            std::min(min_pair_squared, squaredPositionDistance(x_a, followers[b].plant.state(), k));
+      }
+    }
+    if (tick < last_tick) {
+      leader.advance(t, leader_input);
+      for (SimulatedFollower<Dims>& follower : followers) {
+        follower.plant.advance(t, follower.command);
+      }
+    }
+  }
+  formation.min_pair_separation = std::sqrt(min_pair_squared);
+  for (const SimulatedFollower<Dims>& follower : followers) {
+    formation.followers.push_back(follower.summary);
+    formation.targets.push_back(follower.member.target);
+  }
+  return formation;
+}
+
+}  // namespace
+
+FormationSummary simulateFormation(const Scenario& scenario, const FormationObserver& observer) {
+  const ControllerDesign design = ControllerDesign::create(scenario.controller);
+  scenario.validate();
+  return visitDimensions(scenario.controller.model, [&](auto dims) {
+    return runFormation<decltype(dims)>(scenario, design, observer);
+  });
+}
+
+SimulationSummary simulate(const Scenario& scenario, const SampleObserver& observer) {
+  if (scenario.formation.followers != 1) {
+    throw ParameterError("formation.followers",
+                         "simulate() runs one follower; use simulateFormation()");
+  }
+  FormationObserver forward;
+  if (observer) {
+    forward = [&observer](int /*member*/, const SimulationSample& sample) { observer(sample); };
+  }
+  return simulateFormation(scenario, forward).followers.front();
+}
+
+std::string formatSummary(const SimulationSummary& summary, double wall_seconds) {
+  // A stream in the classic locale with precision 9 and the default float format prints each
+  // value exactly as printf's "%.9g" does, without a C varargs call.
+  std::ostringstream line;
+  line.imbue(std::locale::classic());
+  line.precision(9);
+  line << "max_xi=" << summary.max_xi << " max_xi_hat=" << summary.max_xi_hat
+       << " xi_max=" << summary.xi_max << " min_separation=" << summary.min_separation
+       << " time_outside=" << summary.time_outside << " wall_s=" << wall_seconds;
+  return line.str();
+}
+
+}  // namespace projection_collision_avoidance
