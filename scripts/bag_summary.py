@@ -78,7 +78,7 @@ def summarize(path):
         topic = status_topic(bag, path)
         for _, msg, rec in bag.read_messages(topics=[topic], raw=False):
             rows.append((stamp_of(msg, rec), msg.xi_norm, msg.xi_hat_norm, msg.xi_max,
-                         msg.separation, rec.to_sec()))
+                         msg.distance, rec.to_sec()))
     if not rows:
         raise SummaryError(f"{path}: {topic} has no messages")
 

@@ -246,7 +246,7 @@ def load_bag(path):
         for i in range(k):
             cols[f"{who}_v_{i}"] = np.interp(t_abs, ts, vel[:, i])
 
-    cols["separation"] = np.array([s.separation for s in msgs], dtype=float)
+    cols["separation"] = np.array([s.distance for s in msgs], dtype=float)
     cols["perimeter"] = np.array([s.perimeter for s in msgs], dtype=float)
     for prefix, field in (("u", "command"), ("u_baseline", "baseline_command"),
                           ("u_tracker", "tracker_command")):

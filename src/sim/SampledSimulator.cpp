@@ -151,15 +151,10 @@ FormationSummary runFormation(const Scenario& scenario, const ControllerDesign& 
         SimulationSample sample;
         sample.time = t;
         sample.relative_error = xi;
-        sample.estimate = status.estimate;
-        sample.constraint_value = status.constraint_value;
-        sample.projection_active = status.projection_active;
         sample.leader_state = target_state;
         sample.follower_state = follower.plant.state();
-        sample.separation = separation;
-        sample.command = status.command;
-        sample.baseline_command = status.baseline_command;
-        sample.tracker_command = status.tracker_command;
+        sample.distance = separation;
+        sample.controller = status;
         sample.leader_input = behind_leader ? leader_input : ahead->command;
         sample.disturbance = behind_leader ? disturbance : zero_disturbance;
         observer(follower.member.index - 1, sample);

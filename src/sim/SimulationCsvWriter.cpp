@@ -55,19 +55,19 @@ SimulationCsvWriter::SimulationCsvWriter(std::ostream& out, const Scenario& scen
 void SimulationCsvWriter::write(const SimulationSample& s) {
   out_ << s.time;
   writeValues(out_, s.relative_error, states_);
-  writeValues(out_, s.estimate, states_);
-  out_ << ',' << s.relative_error.norm() << ',' << s.estimate.norm() << ',' << xi_max_ << ','
-       << xi_soft_ << ',' << s.constraint_value << ',' << (s.projection_active ? 1 : 0);
+  writeValues(out_, s.controller.estimate, states_);
+  out_ << ',' << s.relative_error.norm() << ',' << s.controller.estimate.norm() << ',' << xi_max_ << ','
+       << xi_soft_ << ',' << s.controller.constraint_value << ',' << (s.controller.projection_active ? 1 : 0);
   writeValues(out_, s.leader_state, positions_);
   writeValues(out_, s.follower_state, positions_);
   if (velocities_) {
     writeValues(out_, s.leader_state.tail(positions_), positions_);
     writeValues(out_, s.follower_state.tail(positions_), positions_);
   }
-  out_ << ',' << s.separation << ',' << perimeter_;
-  writeValues(out_, s.command, inputs_);
-  writeValues(out_, s.baseline_command, inputs_);
-  writeValues(out_, s.tracker_command, inputs_);
+  out_ << ',' << s.distance << ',' << perimeter_;
+  writeValues(out_, s.controller.command, inputs_);
+  writeValues(out_, s.controller.baseline_command, inputs_);
+  writeValues(out_, s.controller.tracker_command, inputs_);
   writeValues(out_, s.leader_input, inputs_);
   writeValues(out_, s.disturbance, states_);
   out_ << '\n';

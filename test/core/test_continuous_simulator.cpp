@@ -55,7 +55,7 @@ double largestDifference(const std::vector<SimulationSample>& a,
   for (std::size_t k = 0; k < std::min(a.size(), b.size()); ++k) {
     EXPECT_NEAR(a[k].time, b[k].time, 1e-9);
     largest = std::max(largest, (a[k].relative_error - b[k].relative_error).norm());
-    largest = std::max(largest, (a[k].estimate - b[k].estimate).norm());
+    largest = std::max(largest, (a[k].controller.estimate - b[k].controller.estimate).norm());
   }
   return largest;
 }
@@ -81,8 +81,8 @@ TEST(ContinuousSimulator, Run1LeavesTheBoundWhileTheEstimateStaysInside) {
   EXPECT_GT(s.max_xi_hat, 0.999 * s.xi_max);  // the estimate rides the bound
   bool projected = false;
   for (const SimulationSample& sample : samples) {
-    ASSERT_LE(sample.estimate.norm(), s.xi_max) << "t=" << sample.time;
-    projected = projected || sample.projection_active;
+    ASSERT_LE(sample.controller.estimate.norm(), s.xi_max) << "t=" << sample.time;
+    projected = projected || sample.controller.projection_active;
   }
   EXPECT_TRUE(projected);
   // The projection keeps the exact solution in Omega_1; RK4 leaves it by next to nothing.
@@ -166,7 +166,7 @@ TEST(ContinuousSimulator, SampledControllerConvergesToItUnderSaturation) {
     long tick = 0;
     double saturated_time = 0.0;  // s with ||u_2|| at the limit
     const SimulationSummary sampled = simulate(scenario, [&](const SimulationSample& s) {
-      saturated_time += s.command.norm() > limit * (1.0 - 1e-12) ? 1.0 / rate : 0.0;
+      saturated_time += s.controller.command.norm() > limit * (1.0 - 1e-12) ? 1.0 / rate : 0.0;
       if (tick++ % every == 0) {
         samples.push_back(s);
       }

@@ -102,7 +102,7 @@ TEST(Theorem32, TrackingErrorDecays) {
   std::vector<double> norms;
   simulate(scenario, [&](const SimulationSample& s) {
     times.push_back(s.time);
-    errors.push_back((s.relative_error - s.estimate).norm());
+    errors.push_back((s.relative_error - s.controller.estimate).norm());
     norms.push_back(s.relative_error.norm());
   });
   ASSERT_GT(errors.front(), 1.0);

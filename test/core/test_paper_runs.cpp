@@ -38,10 +38,10 @@ TEST(PaperRuns, Run1LeavesTheBoundWhileTheEstimateStaysInside) {
   EXPECT_LE(s.max_xi_hat, s.xi_max);
   EXPECT_GT(s.max_xi_hat, 0.999 * s.xi_max);  // the estimate saturates on the bound
   for (const SimulationSample& sample : trace.samples) {
-    ASSERT_LE(sample.estimate.norm(), s.xi_max) << "t=" << sample.time;
+    ASSERT_LE(sample.controller.estimate.norm(), s.xi_max) << "t=" << sample.time;
     // Before the disturbance and once xi has settled back, the estimate is xi.
     if (sample.time < 20.0 || sample.time > 40.0) {
-      ASSERT_LT((sample.estimate - sample.relative_error).norm(), 1e-3) << "t=" << sample.time;
+      ASSERT_LT((sample.controller.estimate - sample.relative_error).norm(), 1e-3) << "t=" << sample.time;
     }
   }
   // The RK4 safeguard on the sphere removes next to nothing: the projection does the work.
@@ -61,7 +61,7 @@ TEST(PaperRuns, Run2StaysInsideTheBound) {
   // While u_d acts the estimator, blind to it, is biased; afterwards xi returns to xi_hat.
   for (const SimulationSample& sample : trace.samples) {
     if (sample.time > 45.0) {
-      ASSERT_LT((sample.estimate - sample.relative_error).norm(), 1e-3) << "t=" << sample.time;
+      ASSERT_LT((sample.controller.estimate - sample.relative_error).norm(), 1e-3) << "t=" << sample.time;
     }
   }
 }
@@ -99,8 +99,8 @@ TEST(PaperRuns, RotatedIntoTwoAndThreeDimensionsGivesTheSameNorms) {
         const SimulationSample& a = reference.samples[k];
         const SimulationSample& b = rotated.samples[k];
         ASSERT_NEAR(a.relative_error.norm(), b.relative_error.norm(), 1e-9) << "t=" << a.time;
-        ASSERT_NEAR(a.estimate.norm(), b.estimate.norm(), 1e-9) << "t=" << a.time;
-        ASSERT_NEAR(a.command.norm(), b.command.norm(), 1e-9) << "t=" << a.time;
+        ASSERT_NEAR(a.controller.estimate.norm(), b.controller.estimate.norm(), 1e-9) << "t=" << a.time;
+        ASSERT_NEAR(a.controller.command.norm(), b.controller.command.norm(), 1e-9) << "t=" << a.time;
       }
     }
   }
@@ -113,7 +113,7 @@ TEST(PaperRuns, AccelerationLimitBoundsTheCommand) {
   const Trace free_run = run(loadScenarioFile(scenarioPath("paper_run2.yaml")));
   double largest = 0.0;
   for (const SimulationSample& sample : free_run.samples) {
-    largest = std::max(largest, sample.command.norm());
+    largest = std::max(largest, sample.controller.command.norm());
   }
   const double limit = 0.8 * largest;
   Scenario scenario = loadScenarioFile(scenarioPath("paper_run2.yaml"));
@@ -121,15 +121,15 @@ TEST(PaperRuns, AccelerationLimitBoundsTheCommand) {
   const Trace limited = run(scenario);
   int saturated = 0;
   for (const SimulationSample& sample : limited.samples) {
-    ASSERT_LE(sample.command.norm(), limit * (1.0 + 1e-12)) << "t=" << sample.time;
-    ASSERT_LE(sample.estimate.norm(), limited.summary.xi_max);
-    const Eigen::VectorXd sum = sample.baseline_command + sample.tracker_command;
+    ASSERT_LE(sample.controller.command.norm(), limit * (1.0 + 1e-12)) << "t=" << sample.time;
+    ASSERT_LE(sample.controller.estimate.norm(), limited.summary.xi_max);
+    const Eigen::VectorXd sum = sample.controller.baseline_command + sample.controller.tracker_command;
     if (sum.norm() > limit) {
       ++saturated;
-      EXPECT_NEAR(sample.command.norm(), limit, 1e-9);
-      EXPECT_NEAR(sample.command.normalized().dot(sum.normalized()), 1.0, 1e-12);  // direction
+      EXPECT_NEAR(sample.controller.command.norm(), limit, 1e-9);
+      EXPECT_NEAR(sample.controller.command.normalized().dot(sum.normalized()), 1.0, 1e-12);  // direction
     } else {
-      ASSERT_NEAR((sample.command - sum).norm(), 0.0, 1e-12);
+      ASSERT_NEAR((sample.controller.command - sum).norm(), 0.0, 1e-12);
     }
   }
   EXPECT_GT(saturated, 0);

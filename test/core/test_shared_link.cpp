@@ -279,7 +279,7 @@ Trace trace(const std::string& file, const std::vector<std::string>& overrides) 
       [&result](int member, const SimulationSample& s) {
         result.values.push_back(member);
         for (const Eigen::VectorXd* v :
-             {&s.relative_error, &s.estimate, &s.command, &s.tracker_command, &s.follower_state}) {
+             {&s.relative_error, &s.controller.estimate, &s.controller.command, &s.controller.tracker_command, &s.follower_state}) {
           result.values.insert(result.values.end(), v->data(), v->data() + v->size());
         }
       });

@@ -80,9 +80,9 @@ TEST(TimeHeadway, TheGapGrowsWithSpeedAndTheEstimatorFollows) {
   const SimulationSample& last = run.back();
   EXPECT_NEAR(last.relative_error(0), 1.0, 1e-4);
   EXPECT_NEAR(last.relative_error(1), 0.0, 1e-4);
-  EXPECT_NEAR((last.estimate - last.relative_error).norm(), 0.0, 1e-4);
-  EXPECT_NEAR(last.tracker_command.norm(), 0.0, 1e-3);
-  EXPECT_NEAR(last.separation, 6.0, 1e-4);
+  EXPECT_NEAR((last.controller.estimate - last.relative_error).norm(), 0.0, 1e-4);
+  EXPECT_NEAR(last.controller.tracker_command.norm(), 0.0, 1e-3);
+  EXPECT_NEAR(last.distance, 6.0, 1e-4);
   // Reversing at 2 m/s the slot comes 1 m closer; the bound is still on xi.
   EXPECT_NEAR(cruise(-2.0, 0.5, 40.0).back().relative_error(0), -1.0, 1e-4);
 }
@@ -93,8 +93,8 @@ TEST(TimeHeadway, TheEstimateStaysInOmega1WhenTheHeadwayAsksForMore) {
   const std::vector<SimulationSample> run = cruise(10.0, 0.6, 40.0);
   bool projected = false;
   for (const SimulationSample& s : run) {
-    ASSERT_LE(s.estimate.norm(), 4.0 + 1e-9) << s.time;
-    projected = projected || s.projection_active;
+    ASSERT_LE(s.controller.estimate.norm(), 4.0 + 1e-9) << s.time;
+    projected = projected || s.controller.projection_active;
   }
   EXPECT_TRUE(projected);
   EXPECT_LT(run.back().relative_error.norm(), 6.0 - 1.0);  // the tracker won most of it back

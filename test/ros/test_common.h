@@ -45,7 +45,7 @@ inline void addStatus(const FollowerStatus& msg, StatusRecord* record) {
   ++record->count;
   record->max_xi = std::max(record->max_xi, msg.xi_norm);
   record->max_xi_hat = std::max(record->max_xi_hat, msg.xi_hat_norm);
-  record->min_separation = std::min(record->min_separation, msg.separation);
+  record->min_separation = std::min(record->min_separation, msg.distance);
   double squared = 0.0;
   for (const double u : msg.command) {
     record->commands_finite = record->commands_finite && std::isfinite(u);

@@ -74,7 +74,7 @@ TEST_F(FollowerTest, PublishesStatusWithTheScenariosBounds) {
   EXPECT_FALSE(s.command_saturated);
   EXPECT_FALSE(s.command_rate_limited);
   EXPECT_TRUE(std::isinf(s.jerk_limit));
-  EXPECT_NEAR(s.separation, 5.0, 0.05);  // before the disturbance the follower holds its slot
+  EXPECT_NEAR(s.distance, 5.0, 0.05);  // before the disturbance the follower holds its slot
 }
 
 TEST_F(FollowerTest, PublishesMarkersInTheFollowerFrame) {

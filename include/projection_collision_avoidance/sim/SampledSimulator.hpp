@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 
+#include "projection_collision_avoidance/core/FollowerControllerStatus.hpp"
 #include "projection_collision_avoidance/sim/Scenario.hpp"
 
 namespace projection_collision_avoidance {
@@ -15,17 +16,14 @@ namespace projection_collision_avoidance {
 struct SimulationSample {
   double time = 0.0;               ///< t_k (s)
   Eigen::VectorXd relative_error;  ///< xi = x_1 - x_2 - d
-  Eigen::VectorXd estimate;        ///< xi_hat used at t_k
-  double constraint_value = 0.0;   ///< f(xi_hat)
-  bool projection_active = false;
-  Eigen::VectorXd leader_state;      ///< x_1
-  Eigen::VectorXd follower_state;    ///< x_2
-  double separation = 0.0;           ///< ||p_1 - p_2|| (m)
-  Eigen::VectorXd command;           ///< u_2
-  Eigen::VectorXd baseline_command;  ///< G y
-  Eigen::VectorXd tracker_command;   ///< u_a
-  Eigen::VectorXd leader_input;      ///< the target's acceleration input (u_1(t_k) for the leader)
-  Eigen::VectorXd disturbance;       ///< the target's disturbance (u_d(t_k) for the leader, else 0)
+  Eigen::VectorXd leader_state;    ///< x_1
+  Eigen::VectorXd follower_state;  ///< x_2
+  double distance = 0.0;           ///< ||p_1 - p_2|| (m)
+  Eigen::VectorXd leader_input;    ///< the target's acceleration input (u_1(t_k) for the leader)
+  Eigen::VectorXd disturbance;     ///< the target's disturbance (u_d(t_k) for the leader, else 0)
+  /// The controller's status at t_k, the one type the nodes publish (estimate, f, projection,
+  /// command and its parts); the continuous loop fills the fields it has.
+  DynamicFollowerStatus controller;
 };
 
 /// The figures of a run; norms are taken at the control ticks.

@@ -44,7 +44,7 @@ FollowerStatus toStatusMsg(const FollowerCycleOutput& out, const FollowerInputSt
   msg.headway_command = toStdVector(s.headway_command);
   msg.own_state_fresh = out.own_state_fresh;
   msg.fallback_command = toStdVector(s.fallback_command);
-  msg.separation = out.distance;
+  msg.distance = out.distance;
   msg.perimeter = out.perimeter;
   msg.ticks = out.steps;
   msg.missed_periods = out.missed_periods;
