@@ -46,7 +46,7 @@ rm -rf "$build_dir/test_results"
   exit 1
 }
 # Test cases from the gtest XML files (test_results/*.xml): "passed failed".
-read -r passed failed _ < <(/usr/bin/python3 "$root/scripts/count_test_results.py" "$build_dir/test_results")
+read -r passed failed _ < <(/usr/bin/python3 "$root/test/tools/count_test_results.py" "$build_dir/test_results")
 echo "sanitizer gtests: $passed passed, $failed failed"
 if [[ $failed -ne 0 || $passed -eq 0 ]]; then
   echo "sanitize: core gtests failed"

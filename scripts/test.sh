@@ -24,7 +24,7 @@ make -C "$build_dir" run_tests >"$build_dir/run_tests.log" 2>&1 || {
 results_ok=true
 catkin_test_results --verbose "$build_dir/test_results" || results_ok=false
 # Count test cases from the JUnit files: "passed failed skipped".
-read -r passed failed skipped < <(/usr/bin/python3 "$root/scripts/count_test_results.py" "$build_dir/test_results")
+read -r passed failed skipped < <(/usr/bin/python3 "$root/test/tools/count_test_results.py" "$build_dir/test_results")
 if [[ $results_ok != true || $failed -ne 0 || $passed -eq 0 ]]; then
   echo "$passed passed, $failed failed"
   echo "test: failing tests above"
@@ -66,6 +66,6 @@ SANITIZE_BUILD_DIR=$sanitize_dir "$root/scripts/sanitize.sh" --fuzz-seconds "$fu
   exit 1
 }
 # The same count over the sanitizer build's gtest XML.
-read -r san_passed san_failed san_skipped < <(/usr/bin/python3 "$root/scripts/count_test_results.py" "$sanitize_dir/test_results")
+read -r san_passed san_failed san_skipped < <(/usr/bin/python3 "$root/test/tools/count_test_results.py" "$sanitize_dir/test_results")
 echo "$passed passed, $failed failed, $skipped skipped" \
   "(and under ASan + UBSan: $san_passed passed, $san_failed failed; fuzzed $fuzz_seconds s)"

@@ -1,6 +1,6 @@
 /// Google Benchmark of one control step of the follower (1-D, 2-D and 3-D double integrators,
 /// with the estimate inside the bound and held on it by the projection) and of whole cf_sim runs
-/// of the paper's scenario. Not a test: scripts/performance.sh runs it.
+/// of the paper's scenario. Not a test: experiments/performance/run.sh runs it.
 ///
 /// Counters: substeps (RK4 substeps per period), allocations (heap allocations per step, counted
 /// by test/common/AllocationCounter.cpp), flops (StepFlops.hpp) and flops_per_ns.

@@ -1,5 +1,5 @@
 /// Runs STEPS control steps of the follower, as benchmark_follower_step does, for an instruction
-/// count under callgrind (scripts/step_instructions.sh runs it at two step counts and divides the
+/// count under callgrind (experiments/performance/run.sh runs it at two step counts and divides the
 /// difference, so that start-up cancels out).
 /// Usage: step_instructions AXES(1|2|3) STEPS inside|outside
 

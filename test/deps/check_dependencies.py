@@ -55,11 +55,16 @@ WRAPPERS = {"exec": (0, set()), "sudo": (0, {"-u", "-g"}), "nohup": (0, set()),
             "taskset": (1, set())}
 # Scripts that build, test and measure the package: what only they use may be a test_depend.
 DEVELOPMENT_SCRIPTS = {"scripts/test.sh", "scripts/build.sh", "scripts/sanitize.sh",
-                       "scripts/setup.sh", "scripts/count_test_results.py",
-                       "scripts/performance.sh", "scripts/performance_report.py",
-                       "scripts/solver_comparison.py", "scripts/ros_latency.sh",
-                       "scripts/ros_latency.py", "scripts/fault_table.sh",
-                       "scripts/check_workspace.sh"}
+                       "scripts/setup.sh", "scripts/check_workspace.sh",
+                       "experiments/performance/run.sh",
+                       "experiments/performance/performance_report.py",
+                       "experiments/performance/solver_comparison.py",
+                       "experiments/ros_latency/run.sh", "experiments/ros_latency/ros_latency.py",
+                       "experiments/fault_table/run.sh"}
+# Files under test/ that the package installs as programs: what they use is a run-time need.
+INSTALLED_PROGRAMS = {"test/reference/reference_sim.py"}
+# The experiments' shared Python helpers, imported by the experiments as local modules.
+EXPERIMENT_HELPERS = Path("experiments") / "common"
 # Debian packages used by the scripts but not dependencies of the package: catkin's own
 # toolchain, and the workspace tools a user picks. They are in scripts/debian-packages.txt.
 TOOLCHAIN = {"make", "cmake", "catkin", "catkin-tools", "colcon", "python3-colcon-ros",
@@ -92,6 +97,8 @@ def source_files(root, suffixes):
 def is_test_path(root, path):
     """Tests, and the scripts that build, test and measure the package (not run by its users)."""
     relative = Path(path).relative_to(root)
+    if relative.as_posix() in INSTALLED_PROGRAMS:
+        return False
     return relative.parts[0] in ("test", ".ci") or relative.as_posix() in DEVELOPMENT_SCRIPTS
 
 
@@ -103,6 +110,8 @@ def python_uses(root, path):
     """Imports and started programs of one Python file."""
     tree = ast.parse(path.read_text(), filename=str(path))
     local = {p.stem for p in path.parent.glob("*.py")}
+    if path.relative_to(root).parts[0] == EXPERIMENT_HELPERS.parts[0]:
+        local |= {p.stem for p in (root / EXPERIMENT_HELPERS).glob("*.py")}
     test_only = is_test_path(root, path)
     where = lambda node: f"{path.relative_to(root)}:{node.lineno}"  # noqa: E731
     for node in ast.walk(tree):

@@ -1,5 +1,5 @@
 /// Latency probe of the follower pipeline (test/performance/latency.launch,
-/// scripts/ros_latency.sh).
+/// experiments/ros_latency/run.sh).
 ///
 /// Publishes RelativeMeasurement on `relative_measurement` at ~rate Hz from a thread of its own
 /// (clock_nanosleep(TIMER_ABSTIME) on CLOCK_MONOTONIC; a wake-up more than a period late skips

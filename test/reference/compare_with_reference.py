@@ -4,7 +4,7 @@
 Usage::
 
     compare_with_reference.py --cf-sim PATH_TO_CF_SIM --scenarios-dir config/scenarios
-                              [--tolerance 0.02] [--reference scripts/reference_sim.py]
+                              [--tolerance 0.02] [--reference test/reference/reference_sim.py]
                               [--case NAME]... [--jobs N] [--list]
                               [--cf-sim-arg=ARG]... [--reference-arg=ARG]...
 
@@ -43,7 +43,7 @@ from pathlib import Path
 
 PYTHON = "/usr/bin/python3"
 HERE = Path(__file__).resolve().parent
-DEFAULT_REFERENCE = HERE.parent.parent / "scripts" / "reference_sim.py"
+DEFAULT_REFERENCE = HERE / "reference_sim.py"
 COMPARED = ("max_xi", "max_xi_hat", "min_separation")
 REQUIRED = COMPARED + ("xi_max",)
 BOUND_SLACK = 1e-9        # m: cf_sim's estimate must stay in ||xi_hat|| <= xi_max + this
@@ -233,7 +233,7 @@ def parse_args(argv):
                     help="largest allowed difference of max_xi, max_xi_hat, min_separation, m "
                          "(default 0.02)")
     ap.add_argument("--reference", default=str(DEFAULT_REFERENCE), metavar="PATH",
-                    help="reference simulator (default: scripts/reference_sim.py of this repo)")
+                    help="reference simulator (default: reference_sim.py beside this file)")
     ap.add_argument("--cf-sim-arg", action="append", default=[], metavar="ARG",
                     help="extra argument for cf_sim, e.g. --cf-sim-arg=--foo (repeatable)")
     ap.add_argument("--reference-arg", action="append", default=[], metavar="ARG",

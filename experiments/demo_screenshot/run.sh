@@ -2,11 +2,11 @@
 # Takes the rviz screenshots of doc/nodes.md: demo.launch (the paper's Run 2) under Xvfb, captured at
 # a simulated time. Without arguments: t ~ 21.5 s, while the leader is pushed back, into
 # doc/rviz_run2.png. Further arguments go to roslaunch, e.g. for the fallback:
-#   scripts/make_screenshot.sh 27 doc/rviz_fallback.png acceleration_limit:=6 \
+#   experiments/demo_screenshot/run.sh 27 doc/rviz_fallback.png acceleration_limit:=6 \
 #     measurement_outage_start:=25 measurement_outage_duration:=3
-# Usage: scripts/make_screenshot.sh [simulated_seconds [output.png [roslaunch args...]]]
+# Usage: experiments/demo_screenshot/run.sh [simulated_seconds [output.png [roslaunch args...]]]
 set -euo pipefail
-root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
 at=${1:-21.5}
 output=${2:-$root/doc/rviz_run2.png}
 shift $(( $# < 2 ? $# : 2 ))

@@ -2,9 +2,9 @@
 # Regenerates the figures in doc/ from cf_sim runs of the paper's scenario:
 #   doc/paper_runs.png       Run 1 (tracker off) and Run 2 (tracker on) side by side, 0-60 s
 #   doc/paper_runs_zoom.png  the same, 15-35 s around the disturbance
-# Usage: scripts/make_figures.sh   (builds first; BUILD_DIR as for scripts/build.sh)
+# Usage: experiments/paper_runs/run.sh   (builds first; BUILD_DIR as for scripts/build.sh)
 set -euo pipefail
-root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
 build_dir=${BUILD_DIR:-$root/build}
 BUILD_DIR=$build_dir "$root/scripts/build.sh" >/dev/null
 cf_sim=$build_dir/devel/lib/projection_collision_avoidance/cf_sim

@@ -3,18 +3,20 @@
 #   1. Google Benchmark: one control step in 1-D, 2-D, 3-D (inside the bound and held on it by
 #      the projection), heap allocations and flops per step; whole Run 2 in process;
 #   2. callgrind: instructions per control step (load-independent);
-#   3. cf_sim against the SciPy LSODA reference, whole processes (scripts/solver_comparison.py);
+#   3. cf_sim against the SciPy LSODA reference, whole processes (solver_comparison.py, beside
+#      this script);
 #   4. the ROS follower at 1 kHz on real time next to a bare roscpp relay
-#      (scripts/ros_latency.sh, into doc/ros_latency.csv), unless --skip-ros (then the figures
-#      of its last run in doc/ros_latency.csv);
-#   5. platoon scale: scripts/formation_scale.sh with --with-scale (18 min), else the figures of
-#      its last run in doc/formation_scale.md.
+#      (experiments/ros_latency/run.sh, into doc/ros_latency.csv), unless --skip-ros (then the
+#      figures of its last run in doc/ros_latency.csv);
+#   5. platoon scale: experiments/formation_scale/run.sh with --with-scale (18 min), else the
+#      figures of its last run in doc/formation_scale.md.
 # Writes the raw figures to doc/performance_data/, then doc/performance.md and the table between
 # the performance markers of doc/performance_summary.md; --report-only renders those two from the raw figures.
-# Usage: scripts/performance.sh [--reps N] [--ros-runs N] [--ros-duration S] [--skip-ros]
-#                               [--with-scale] [--no-summary] [--report-only]
+# Usage: experiments/performance/run.sh [--reps N] [--ros-runs N] [--ros-duration S]
+#          [--skip-ros] [--with-scale] [--no-summary] [--report-only]
 set -euo pipefail
-root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
+root=$(cd "$here/../.." && pwd)
 build_dir=${BUILD_DIR:-$root/build}
 reps=10
 ros_runs=3
@@ -71,18 +73,18 @@ for axes in 1 2 3; do
 done
 
 echo "== 3/5 cf_sim against SciPy LSODA ($reps repetitions)" >&2
-/usr/bin/python3 "$root/scripts/solver_comparison.py" --cf-sim "$bin/cf_sim" --reps "$reps" \
+/usr/bin/python3 "$here/solver_comparison.py" --cf-sim "$bin/cf_sim" --reps "$reps" \
   --json "$data/solvers.json" >/dev/null
 
 if [ "$skip_ros" = 0 ]; then
   echo "== 4/5 ROS follower at 1 kHz ($ros_runs runs of $ros_duration s per setting)" >&2
-  bash "$root/scripts/ros_latency.sh" --runs "$ros_runs" --duration "$ros_duration" --realtime \
-    --follower-thread --csv "$root/doc/ros_latency.csv" >/dev/null
+  bash "$root/experiments/ros_latency/run.sh" --runs "$ros_runs" --duration "$ros_duration" \
+    --realtime --follower-thread --csv "$root/doc/ros_latency.csv" >/dev/null
 fi
 
 if [ "$with_scale" = 1 ]; then
-  echo "== 5/5 platoon scale (scripts/formation_scale.sh)" >&2
-  bash "$root/scripts/formation_scale.sh" >/dev/null
+  echo "== 5/5 platoon scale (experiments/formation_scale/run.sh)" >&2
+  bash "$root/experiments/formation_scale/run.sh" >/dev/null
 fi
 
 fi
@@ -91,7 +93,7 @@ summary_args=()
 if [ "$update_summary" = 1 ]; then
   summary_args=(--summary "$root/doc/performance_summary.md")
 fi
-/usr/bin/python3 "$root/scripts/performance_report.py" --benchmark "$data/benchmark.json" \
+/usr/bin/python3 "$here/performance_report.py" --benchmark "$data/benchmark.json" \
   --instructions "$data/instructions.csv" --solvers "$data/solvers.json" \
   --ros-csv "$root/doc/ros_latency.csv" \
   --scale "$root/doc/formation_scale.md" --reps "$(cat "$data/repetitions")" --date "$(cat "$data/date" 2>/dev/null || date +%F)" --out "$root/doc/performance.md" \

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Latency of the follower pipeline (run by scripts/ros_latency.sh, which sets up ROS).
+"""Latency of the follower pipeline (run by experiments/ros_latency/run.sh, which sets up ROS).
 
 `run` launches test/performance/latency.launch RUNS times per setting, each on its own master
 (roslaunch -p PORT), and keeps the probe's JSON of each run; the settings are the machine as it
@@ -29,9 +29,9 @@ import subprocess
 import sys
 import time
 
-from process_control import start_spinners, stop
-
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, os.path.join(ROOT, "experiments", "common"))
+from process_control import start_spinners, stop  # noqa: E402 (from experiments/common/)
 LAUNCH = os.path.join(ROOT, "test", "performance", "latency.launch")
 STREAMS = ("relay", "follower_measurement", "follower_timer")
 FOLLOWERS = ("follower_measurement", "follower_timer")
@@ -201,7 +201,7 @@ def median(rows, key):
 
 def table(rows, args):
     lines = [
-        "ROS pipeline latency, `scripts/ros_latency.sh --runs %d --duration %g` (%g Hz, "
+        "ROS pipeline latency, `experiments/ros_latency/run.sh --runs %d --duration %g` (%g Hz, "
         "paper_run2, real time): medians over the runs of each setting." % (
             args.runs, args.duration, args.rate),
         "",

@@ -3,9 +3,9 @@
 # 5x real time, acceleration limit 6 m/s^2) at a range of fault levels, and writes what held as a
 # Markdown table to doc/fault_table.md (and stdout). Rows marked "tested" are the ones
 # CMakeLists.txt registers as rostests; the others go beyond them.
-# Usage: scripts/fault_table.sh   (builds first; BUILD_DIR as for scripts/build.sh; ~3 min)
+# Usage: experiments/fault_table/run.sh   (builds first; BUILD_DIR as for scripts/build.sh; ~3 min)
 set -euo pipefail
-root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
 build_dir=${BUILD_DIR:-$root/build}
 BUILD_DIR=$build_dir "$root/scripts/build.sh" test_faults_ros >/dev/null
 set +u

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Takes the rviz screenshots of doc/formations.md (formation.launch), as scripts/make_screenshot.sh does for
-# demo.launch: rviz under Xvfb (software OpenGL) on the formation, its window captured with
+# Takes the rviz screenshots of doc/formations.md (formation.launch), as
+# experiments/demo_screenshot/run.sh does for demo.launch: rviz under Xvfb (software OpenGL) on the formation, its window captured with
 # `import` once the plant's simulated time passes the given moment. The master and rviz start
 # first and formation.launch (rviz:=false) only once rviz's window is up; rviz runs a copy of the
 # configuration without its Displays panel, for a wider view.
@@ -10,12 +10,13 @@
 #                                 over the ground grid (rviz/formation_3d.rviz)
 #   doc/rviz_formation_chain.png  paper_run2 (1-D), 5 followers, chain, line, 100 Hz, t = 22 s,
 #                                 side view in a 1280x420 window (rviz/formation_line.rviz)
-# Usage: scripts/formation_screenshots.sh [2d] [3d] [chain]   (default: all three; ~1 min each)
+# Usage: experiments/formation_screenshots/run.sh [2d] [3d] [chain]
+#   (default: all three; ~1 min each)
 #   OUT_DIR (default doc/), REAL_TIME_FACTOR (default 0.5), ROS_PORT (default 11412: its own
 #   master, apart from other tests), SCREEN_DISPLAY (default :98). Needs a built workspace
 #   (scripts/build.sh). The PNGs are reduced to 256 colours (ImageMagick `convert`).
 set -euo pipefail
-root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
 out=${OUT_DIR:-$root/doc}
 rtf=${REAL_TIME_FACTOR:-0.5}
 port=${ROS_PORT:-11412}

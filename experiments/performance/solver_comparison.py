@@ -36,8 +36,8 @@ import time
 
 import numpy as np
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-REFERENCE = os.path.join(ROOT, "scripts", "reference_sim.py")
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+REFERENCE = os.path.join(ROOT, "test", "reference", "reference_sim.py")
 PYTHON = "/usr/bin/python3"
 TRUTH_TOLERANCES = ("1e-12", "1e-14")
 # Steps that land on the 10 Hz grid: 0.1 s / k.

@@ -11,16 +11,17 @@
 #                              tables, and the error propagation |Gamma| of the analysis
 #   string_stability.csv       peak ||xi_i||, bound, min separation and perimeter per follower
 #   string_stability.png       peak ||xi_i|| and min separation against i
-#   string_stability_gamma.png |Gamma(e^{jwT})| against w (scripts/string_stability_analysis.py)
-# Usage: scripts/string_stability.sh [OUT_DIR]   (about 35 s after the build: 44 cf_sim runs, up
-#   to 1 s each, and the analysis). Builds first (BUILD_DIR as for scripts/build.sh), unless
-#   CF_SIM=path/to/cf_sim is given.
+#   string_stability_gamma.png |Gamma(e^{jwT})| against w (string_stability_analysis.py)
+# Usage: experiments/string_stability/run.sh [OUT_DIR]   (about 35 s after the build: 44 cf_sim
+#   runs, up to 1 s each, and the analysis). Builds first (BUILD_DIR as for scripts/build.sh),
+#   unless CF_SIM=path/to/cf_sim is given.
 set -euo pipefail
-root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
+root=$(cd "$here/../.." && pwd)
 out=${1:-$root/doc}
 followers=${FOLLOWERS:-100}
-# shellcheck source=scripts/cf_sim_path.bash
-source "$root/scripts/cf_sim_path.bash"
+# shellcheck source=experiments/common/cf_sim_path.bash
+source "$root/experiments/common/cf_sim_path.bash"
 find_cf_sim string_stability "$root"
 mkdir -p "$out"
 
@@ -123,9 +124,9 @@ wall=$(/usr/bin/python3 -c "import sys; print(f'{float(sys.argv[2]) - float(sys.
   "$start" "$(date +%s.%N)")
 echo "string_stability: ${#runs[@]} cf_sim runs of $followers followers took $wall s"
 
-/usr/bin/python3 "$root/scripts/string_stability_analysis.py" "$platoon" \
+/usr/bin/python3 "$here/string_stability_analysis.py" "$platoon" \
   --md "$work/gamma.md" --png "$out/string_stability_gamma.png"
-/usr/bin/python3 "$root/scripts/plot_string_stability.py" "$manifest" --followers "$followers" \
+/usr/bin/python3 "$here/plot_string_stability.py" "$manifest" --followers "$followers" \
   --wall "$wall" --gamma "$work/gamma.md" --md "$out/string_stability.md" \
   --csv "$out/string_stability.csv" --png "$out/string_stability.png"
 echo "wrote $out/string_stability.md, .csv, .png and string_stability_gamma.png"

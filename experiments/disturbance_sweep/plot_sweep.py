@@ -22,7 +22,7 @@ Writes
            with the scenario's own pulse (--scenario: its first disturbance
            vector, e.g. s = 2.83 at 225 deg for the paper's [-2, -2]) marked.
 
-Rerun everything with scripts/disturbance_sweep.sh.
+Rerun everything with experiments/disturbance_sweep/run.sh.
 """
 
 from __future__ import annotations

@@ -7,9 +7,9 @@
 # Prints a Markdown table of medians over the runs (relay p50/p99, measurement-triggered
 # follower p50/p99 and its added latency over the relay of the same run, timer follower p50/p99,
 # missed and late periods in %) and writes the raw per-run figures to CSV.
-# Usage: scripts/ros_latency.sh [--runs N] [--duration S] [--keep-awake none|both|all] [--realtime]
-#                               [--follower-thread] [--only SETTING[,SETTING...]]
-#                               [--csv FILE] [--rate HZ] [--port PORT] [--work DIR]
+# Usage: experiments/ros_latency/run.sh [--runs N] [--duration S] [--keep-awake none|both|all]
+#          [--realtime] [--follower-thread] [--only SETTING[,SETTING...]]
+#          [--csv FILE] [--rate HZ] [--port PORT] [--work DIR]
 #   --runs      launches per setting (default 3)
 #   --duration  measured seconds per launch (default 60; plus ~10 s of start-up and warm-up)
 #   --keep-awake  none: the machine as it is; all: with one nice-19 busy loop per core, which
@@ -31,7 +31,8 @@
 # Builds what it needs first (BUILD_DIR, default build/). Timing-sensitive: the figures depend on
 # the machine's load (the CSV records the load average and steal time of each run).
 set -euo pipefail
-root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
+root=$(cd "$here/../.." && pwd)
 build_dir=${BUILD_DIR:-$root/build}
 runs=3
 duration=60
@@ -56,11 +57,11 @@ while (($#)); do
     --follower-thread) follower_thread=(--follower-thread); shift ;;
     --only) only=(--only "$2"); shift 2 ;;
     -h|--help) sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0 ;;
-    *) echo "ros_latency.sh: unknown argument $1 (see --help)" >&2; exit 2 ;;
+    *) echo "ros_latency: unknown argument $1 (see --help)" >&2; exit 2 ;;
   esac
 done
 case $keep_awake in none|both|all) ;; *)
-  echo "ros_latency.sh: --keep-awake must be none, both or all" >&2; exit 2 ;;
+  echo "ros_latency: --keep-awake must be none, both or all" >&2; exit 2 ;;
 esac
 [[ -n $work ]] || work=$(mktemp -d /tmp/ros_latency.XXXXXX)
 
@@ -72,6 +73,6 @@ source "$build_dir/devel/setup.bash"
 set -u
 export ROS_MASTER_URI=http://localhost:$port
 echo "ros_latency: work directory (probe JSON, launch and ROS logs): $work" >&2
-/usr/bin/python3 "$root/scripts/ros_latency.py" --runs "$runs" --duration "$duration" \
+/usr/bin/python3 "$here/ros_latency.py" --runs "$runs" --duration "$duration" \
   --rate "$rate" --keep-awake "$keep_awake" --csv "$csv" --port "$port" --work "$work" \
   "${realtime[@]}" "${follower_thread[@]}" "${only[@]}"

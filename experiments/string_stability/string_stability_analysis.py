@@ -21,7 +21,7 @@ maps u_t to u_i by the same Gamma(z), and so xi_i to xi_{i+1}: |Gamma(e^{jwT})| 
 l2 string stability; ||g||_1 (g the impulse response) bounds the growth of peaks (l_inf).
 
 Writes OUT.md (sup_w |Gamma|, where, and ||g||_1 per configuration, rate and delay) and OUT.png
-(|Gamma| against w). Rerun everything with scripts/string_stability.sh.
+(|Gamma| against w). Rerun everything with experiments/string_stability/run.sh.
 """
 
 from __future__ import annotations

@@ -2,11 +2,12 @@
 # The table of doc/faults.md on controller.jerk_limit: Run 2 (config/scenarios/paper_run2.yaml,
 # 1 kHz) at several jerk limits, with and without an acceleration limit of 6 m/s^2: max ||xi||
 # and min separation from cf_sim's summary line. Prints a Markdown table (a second of cf_sim).
-# Usage: scripts/jerk_limit_table.sh   (builds first, unless CF_SIM=path/to/cf_sim is given)
+# Usage: experiments/jerk_limit_table/run.sh   (builds first, unless CF_SIM=path/to/cf_sim is
+#   given)
 set -euo pipefail
-root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
-# shellcheck source=scripts/cf_sim_path.bash
-source "$root/scripts/cf_sim_path.bash"
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
+# shellcheck source=experiments/common/cf_sim_path.bash
+source "$root/experiments/common/cf_sim_path.bash"
 find_cf_sim jerk_limit_table "$root"
 
 field() { sed -n "s/.*$1=\([^ ]*\).*/\1/p" <<<"$2"; }
