@@ -61,7 +61,7 @@ FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh,
         std::make_unique<FollowerOutputs>(nh, private_nh, name, options, parameters.control_rate,
                                           member, parameters.separation, inputs_.get());
     inputs_->start(nh);
-    reconfigure_ = std::make_unique<FollowerReconfigure>(private_nh, name, parameters, cycle_.get(),
+    reconfigure_ = std::make_unique<FollowerReconfigure>(private_nh, name, start, cycle_.get(),
                                                          outputs_.get());
     if (options.control_loop == ControlLoop::kThread) {
       outputs_->startThread([this] { reconfigure_->collectRetired(); });

@@ -4,6 +4,7 @@
 #include <functional>
 #include <limits>
 #include <random>
+#include <type_traits>
 
 #include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
@@ -37,6 +38,10 @@ void expectRefused(const std::function<void(ControllerParameters&)>& change, con
     EXPECT_EQ(std::string(error.what()).rfind(key + ": ", 0), 0u) << error.what();
   }
 }
+
+// A design exists only validated: create() is the one way to make one.
+static_assert(!std::is_default_constructible_v<ControllerDesign>,
+              "ControllerDesign must only be made by ControllerDesign::create()");
 
 TEST(ControllerDesign, AcceptsThePapersParameters) {
   const ControllerDesign design = ControllerDesign::create(paperParameters());

@@ -7,9 +7,11 @@
 namespace projection_collision_avoidance {
 
 /// Validated controller parameters and the quantities derived from them once, at load time.
-/// The only way to build one is create(), which refuses any parameter set the theory does not
-/// cover, naming the offending key.
-struct ControllerDesign {
+/// The only way to make one is create(), which refuses any parameter set the theory does not
+/// cover, naming the offending key (there is no default constructor; copies are designs too).
+/// Its fields are read, never written, outside create().
+class ControllerDesign {
+ public:
   ControllerParameters parameters;
   double period = 0.0;                   ///< control period T = 1 / control_rate (s)
   double xi_max = 0.0;                   ///< hard bound (1 - alpha) ||d|| (4) (m)
@@ -47,6 +49,9 @@ struct ControllerDesign {
   /// @param disturbance u_d (n entries: m/s, then m/s^2), or empty when unknown
   Eigen::VectorXd leaderAcceleration(const Eigen::VectorXd& leader_input,
                                      const Eigen::VectorXd& disturbance) const;
+
+ private:
+  ControllerDesign() = default;
 };
 
 }  // namespace projection_collision_avoidance

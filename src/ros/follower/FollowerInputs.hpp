@@ -80,7 +80,8 @@ class FollowerInputs {
 
   std::string name_;
   FollowerNodeOptions options_;
-  ControllerDesign design_;
+  ControllerDesign design_;  ///< the start's: what the inputs read of it (period, time headway,
+                             ///< a_1) does not change by reconfiguration
   int axes_;
   FollowerCycle* cycle_;
   StepSink on_step_;

@@ -11,16 +11,16 @@
 namespace projection_collision_avoidance {
 
 FollowerReconfigure::FollowerReconfigure(ros::NodeHandle private_nh, std::string node_name,
-                                         const ControllerParameters& file_parameters,
+                                         const ControllerDesign& file_design,
                                          FollowerCycle* cycle, FollowerOutputs* outputs)
     : name_(std::move(node_name)),
-      file_parameters_(file_parameters),
-      parameters_(file_parameters),
+      file_parameters_(file_design.parameters),
+      design_(file_design),
       cycle_(cycle),
       outputs_(outputs),
       server_(server_mutex_, private_nh) {
-  outputs_->describeTrackerGain(parameters_.tracker_gain);
-  applied_ = configOf(parameters_);
+  outputs_->describeTrackerGain(design_.parameters.tracker_gain);
+  applied_ = configOf(design_.parameters);
   server_.updateConfig(applied_);
   server_.setCallback(
       [this](FollowerConfig& config, uint32_t level) { onReconfigure(config, level); });
@@ -44,7 +44,7 @@ void FollowerReconfigure::collectRetired() {
 void FollowerReconfigure::onReconfigure(FollowerConfig& config, uint32_t /*level*/) {
   const std::lock_guard<std::mutex> lock(mutex_);
   cycle_->retired().reset();
-  ControllerParameters candidate = parameters_;
+  ControllerParameters candidate = design_.parameters;
   candidate.tracker_enabled = config.tracker_enabled;
   candidate.alpha = config.alpha;
   candidate.epsilon = config.epsilon;
@@ -76,17 +76,16 @@ void FollowerReconfigure::onReconfigure(FollowerConfig& config, uint32_t /*level
     }
     auto controller =
         std::make_unique<DynamicFollowerController>(ControllerDesign::create(candidate));
-    const double xi_max = controller->design().xi_max;
+    design_ = controller->design();
     cycle_->offer(std::move(controller)).reset();  // an offer not yet adopted is superseded
-    parameters_ = candidate;
-    outputs_->describeTrackerGain(parameters_.tracker_gain);
+    outputs_->describeTrackerGain(design_.parameters.tracker_gain);
     ROS_INFO_STREAM(name_ << ": reconfigured: tracker "
                           << (candidate.tracker_enabled ? "on" : "off") << ", alpha "
                           << candidate.alpha << ", epsilon " << candidate.epsilon
                           << ", tracker gain "
                           << (config.tracker_natural_frequency > 0.0 ? "from the frequency"
                                                                      : "of the scenario file")
-                          << ", xi_max " << xi_max << " m");
+                          << ", xi_max " << design_.xi_max << " m");
     applied_ = config;
   } catch (const ParameterError& error) {
     ROS_ERROR_STREAM(name_ << ": reconfiguration refused, previous values kept: " << error.what());

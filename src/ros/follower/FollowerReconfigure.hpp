@@ -24,9 +24,10 @@ namespace projection_collision_avoidance {
 /// the configuration in force published back.
 class FollowerReconfigure {
  public:
-  /// @param file_parameters the scenario's parameters of this follower (the frequency-0 gain)
+  /// @param file_design the design of this follower from the scenario (the frequency-0 gain),
+  ///        the one the cycle starts with
   FollowerReconfigure(ros::NodeHandle private_nh, std::string node_name,
-                      const ControllerParameters& file_parameters, FollowerCycle* cycle,
+                      const ControllerDesign& file_design, FollowerCycle* cycle,
                       FollowerOutputs* outputs);
 
   /// Destroys the controller the cycle replaced last, if any (off the control thread).
@@ -38,7 +39,7 @@ class FollowerReconfigure {
 
   std::string name_;
   ControllerParameters file_parameters_;
-  ControllerParameters parameters_;  ///< in force: those of the last design built
+  ControllerDesign design_;  ///< in force: the last design built (the cycle's once adopted)
   FollowerCycle* cycle_;
   FollowerOutputs* outputs_;
   std::mutex mutex_;  ///< collectRetired() from the outputs' thread vs the callback
