@@ -10,10 +10,6 @@
 
 namespace projection_collision_avoidance {
 
-/// The status of a controller whose sizes are known at run time: FollowerControllerStatus with
-/// bounded vectors (inline storage: copying one allocates nothing).
-using DynamicFollowerStatus = FollowerControllerStatus<GenericDimensions>;
-
 /// A FollowerController whose compile-time dimensions are chosen at run time from the model
 /// (visitDimensions()): fixed-size for 1/2/3-axis double integrators, bounded otherwise. A step
 /// allocates no memory.

@@ -67,4 +67,8 @@ struct FollowerControllerStatus {
   }
 };
 
+/// The status of a controller whose sizes are known at run time: FollowerControllerStatus with
+/// bounded vectors (inline storage: copying one allocates nothing).
+using DynamicFollowerStatus = FollowerControllerStatus<GenericDimensions>;
+
 }  // namespace projection_collision_avoidance
