@@ -278,10 +278,14 @@ Trace trace(const std::string& file, const std::vector<std::string>& overrides) 
       loadScenarioFile(scenarioPath(file), overrides),
       [&result](int member, const SimulationSample& s) {
         result.values.push_back(member);
-        for (const Eigen::VectorXd* v :
-             {&s.relative_error, &s.controller.estimate, &s.controller.command, &s.controller.tracker_command, &s.follower_state}) {
-          result.values.insert(result.values.end(), v->data(), v->data() + v->size());
-        }
+        const auto append = [&result](const auto& v) {
+          result.values.insert(result.values.end(), v.data(), v.data() + v.size());
+        };
+        append(s.relative_error);
+        append(s.controller.estimate);
+        append(s.controller.command);
+        append(s.controller.tracker_command);
+        append(s.follower_state);
       });
   return result;
 }
