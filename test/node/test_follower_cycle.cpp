@@ -245,8 +245,8 @@ TEST(FollowerCycle, TheWaitAfterAStallIsMeasuredOnTheSteadyClock) {
   ASSERT_TRUE(cycle->tick(kStart + kMs, steady, 0.0, 0, &out));
   EXPECT_FALSE(cycle->tick(kStart + 2001 * kMs, steady + 2000 * kMs, 2.0, 199, &out));
   for (int k = 1; k <= 140; ++k) {  // ROS time +1.4 s, steady time +0.14 ms
-    EXPECT_FALSE(cycle->tick(kStart + (2001 + 10 * k) * kMs, steady + 2000 * kMs + k * 1000, 0.0,
-                             0, &out))
+    EXPECT_FALSE(
+        cycle->tick(kStart + (2001 + 10 * k) * kMs, steady + 2000 * kMs + k * 1000, 0.0, 0, &out))
         << k;
   }
   cycle->measurement().write(measurementAt(kStart + 3400 * kMs, 2, 5.0));

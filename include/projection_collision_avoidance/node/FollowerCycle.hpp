@@ -5,8 +5,8 @@
 #include <memory>
 #include <mutex>
 
-#include "projection_collision_avoidance/core/FollowerMode.hpp"
 #include "projection_collision_avoidance/core/DynamicFollowerController.hpp"
+#include "projection_collision_avoidance/core/FollowerMode.hpp"
 #include "projection_collision_avoidance/core/TypeDefs.hpp"
 #include "projection_collision_avoidance/rt/LatestValue.hpp"
 
