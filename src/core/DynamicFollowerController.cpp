@@ -1,6 +1,7 @@
 #include "projection_collision_avoidance/core/DynamicFollowerController.hpp"
 
 #include <stdexcept>
+#include <type_traits>
 #include <utility>
 
 #include "projection_collision_avoidance/core/DimensionDispatch.hpp"
@@ -8,9 +9,10 @@
 namespace projection_collision_avoidance {
 namespace {
 
-template <typename Dims>
-void copyStatus(const FollowerControllerStatus<Dims>& from, DynamicFollowerStatus* to) {
-  *to = from;
+/// @p x as the vector type @p Vector of a controller (fixed-size or bounded).
+template <typename Vector>
+Vector as(const Eigen::Ref<const Eigen::VectorXd>& x) {
+  return Vector(x);
 }
 
 }  // namespace
@@ -35,77 +37,63 @@ DynamicFollowerController::DynamicFollowerController(const ControllerDesign& des
   status_.estimate.setZero(n);
 }
 
+template <typename Call>
+const DynamicFollowerStatus& DynamicFollowerController::visitStep(const Call& call) {
+  std::visit([&](auto& controller) { status_ = call(controller); }, controller_);
+  return status_;
+}
+
+// Each step converts its arguments to the controller's vector types (fixed-size or bounded: no
+// allocation); visitStep() copies the controller's status into the run-time-sized one.
 const DynamicFollowerStatus& DynamicFollowerController::step(
     const Eigen::Ref<const Eigen::VectorXd>& y) {
-  std::visit(
-      [&](auto& controller) {
-        using Controller = std::decay_t<decltype(controller)>;
-        const typename Controller::OutputVector measurement = y;
-        copyStatus(controller.step(measurement), &status_);
-      },
-      controller_);
-  return status_;
+  return visitStep([&](auto& controller) -> const auto& {
+    using C = std::decay_t<decltype(controller)>;
+    return controller.step(as<typename C::OutputVector>(y));
+  });
 }
 
 const DynamicFollowerStatus& DynamicFollowerController::step(
     const Eigen::Ref<const Eigen::VectorXd>& y,
     const Eigen::Ref<const Eigen::VectorXd>& leader_input) {
-  std::visit(
-      [&](auto& controller) {
-        using Controller = std::decay_t<decltype(controller)>;
-        const typename Controller::OutputVector measurement = y;
-        const typename Controller::InputVector input = leader_input;
-        copyStatus(controller.step(measurement, input), &status_);
-      },
-      controller_);
-  return status_;
+  return visitStep([&](auto& controller) -> const auto& {
+    using C = std::decay_t<decltype(controller)>;
+    return controller.step(as<typename C::OutputVector>(y),
+                           as<typename C::InputVector>(leader_input));
+  });
 }
 
 const DynamicFollowerStatus& DynamicFollowerController::stepWithOwnState(
     const Eigen::Ref<const Eigen::VectorXd>& y,
     const Eigen::Ref<const Eigen::VectorXd>& own_state) {
-  std::visit(
-      [&](auto& controller) {
-        using Controller = std::decay_t<decltype(controller)>;
-        const typename Controller::OutputVector measurement = y;
-        const typename Controller::StateVector state = own_state;
-        copyStatus(controller.stepWithOwnState(measurement, state), &status_);
-      },
-      controller_);
-  return status_;
+  return visitStep([&](auto& controller) -> const auto& {
+    using C = std::decay_t<decltype(controller)>;
+    return controller.stepWithOwnState(as<typename C::OutputVector>(y),
+                                       as<typename C::StateVector>(own_state));
+  });
 }
 
 const DynamicFollowerStatus& DynamicFollowerController::stepWithOwnState(
     const Eigen::Ref<const Eigen::VectorXd>& y, const Eigen::Ref<const Eigen::VectorXd>& own_state,
     const Eigen::Ref<const Eigen::VectorXd>& leader_input) {
-  std::visit(
-      [&](auto& controller) {
-        using Controller = std::decay_t<decltype(controller)>;
-        const typename Controller::OutputVector measurement = y;
-        const typename Controller::StateVector state = own_state;
-        const typename Controller::InputVector input = leader_input;
-        copyStatus(controller.stepWithOwnState(measurement, state, input), &status_);
-      },
-      controller_);
-  return status_;
+  return visitStep([&](auto& controller) -> const auto& {
+    using C = std::decay_t<decltype(controller)>;
+    return controller.stepWithOwnState(as<typename C::OutputVector>(y),
+                                       as<typename C::StateVector>(own_state),
+                                       as<typename C::InputVector>(leader_input));
+  });
 }
 
 const DynamicFollowerStatus& DynamicFollowerController::stepFallback() {
-  std::visit([&](auto& controller) { copyStatus(controller.stepFallback(), &status_); },
-             controller_);
-  return status_;
+  return visitStep([&](auto& controller) -> const auto& { return controller.stepFallback(); });
 }
 
 const DynamicFollowerStatus& DynamicFollowerController::stepFallback(
     const Eigen::Ref<const Eigen::VectorXd>& leader_input) {
-  std::visit(
-      [&](auto& controller) {
-        using Controller = std::decay_t<decltype(controller)>;
-        const typename Controller::InputVector input = leader_input;
-        copyStatus(controller.stepFallback(input), &status_);
-      },
-      controller_);
-  return status_;
+  return visitStep([&](auto& controller) -> const auto& {
+    using C = std::decay_t<decltype(controller)>;
+    return controller.stepFallback(as<typename C::InputVector>(leader_input));
+  });
 }
 
 void DynamicFollowerController::setDesign(const ControllerDesign& design) {

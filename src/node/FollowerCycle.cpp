@@ -93,8 +93,8 @@ void FollowerCycle::readInputs(std::int64_t now_ns) {
   have_own_state_ = ever_own_state_ && own_state_.value().receipt_ns <= now_ns;
 }
 
-bool FollowerCycle::tick(std::int64_t now_ns, double delay, std::uint32_t skipped,
-                         FollowerCycleOutput* out) {
+bool FollowerCycle::tick(std::int64_t now_ns, std::int64_t steady_ns, double delay,
+                         std::uint32_t skipped, FollowerCycleOutput* out) {
   // Measurement trigger: a measurement's step may run right now, in its callback; the tick
   // waits for it (the timer trigger never takes the lock).
   std::unique_lock<std::mutex> lock(trigger_mutex_, std::defer_lock);
@@ -118,13 +118,13 @@ bool FollowerCycle::tick(std::int64_t now_ns, double delay, std::uint32_t skippe
     // The tick itself ran late by a good part of the timeout: the process was stalled, and the
     // measurements sent meanwhile are not read yet. Wait for them (at most `grace` s).
     resuming_ = true;
-    resumed_at_ns_ = now_ns;
+    resumed_at_steady_ns_ = steady_ns;
     sequence_at_stall_ = measurement_.value().sequence;
     stall_ = delay;
   }
   if (resuming_) {
     if (measurement_.value().sequence == sequence_at_stall_ &&
-        kNanosecond * static_cast<double>(now_ns - resumed_at_ns_) < grace) {
+        kNanosecond * static_cast<double>(steady_ns - resumed_at_steady_ns_) < grace) {
       addSaturated(&missed_periods_, skipped + 1);
       fillCounters(now_ns, out);
       return false;

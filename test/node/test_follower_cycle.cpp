@@ -235,6 +235,29 @@ TEST(FollowerCycle, AfterAStallItWaitsForTheInputSentMeanwhile) {
   EXPECT_EQ(out.mode, FollowerMode::kMeasurementLost);
 }
 
+TEST(FollowerCycle, TheWaitAfterAStallIsMeasuredOnTheSteadyClock) {
+  // Simulated time catches up when a stalled process resumes: 1.4 s of ROS time within 1 ms of
+  // steady time must not end the wait for the measurements sent meanwhile.
+  std::unique_ptr<FollowerCycle> cycle = makeCycle();
+  FollowerCycleOutput out;
+  const std::int64_t steady = 1000 * kMs;
+  cycle->measurement().write(measurementAt(kStart, 1, 5.0));
+  ASSERT_TRUE(cycle->tick(kStart + kMs, steady, 0.0, 0, &out));
+  EXPECT_FALSE(cycle->tick(kStart + 2001 * kMs, steady + 2000 * kMs, 2.0, 199, &out));
+  for (int k = 1; k <= 140; ++k) {  // ROS time +1.4 s, steady time +0.14 ms
+    EXPECT_FALSE(
+        cycle->tick(kStart + (2001 + 10 * k) * kMs, steady + 2000 * kMs + k * 1000, 0.0, 0, &out))
+        << k;
+  }
+  cycle->measurement().write(measurementAt(kStart + 3400 * kMs, 2, 5.0));
+  ASSERT_TRUE(cycle->tick(kStart + 3410 * kMs, steady + 2001 * kMs, 0.0, 0, &out));
+  EXPECT_EQ(out.mode, FollowerMode::kTracking);
+  // Half the timeout of steady time without a measurement ends the wait: then the fallback.
+  EXPECT_FALSE(cycle->tick(kStart + 6000 * kMs, steady + 4500 * kMs, 2.0, 0, &out));
+  ASSERT_TRUE(cycle->tick(kStart + 6010 * kMs, steady + 4800 * kMs, 0.0, 0, &out));
+  EXPECT_EQ(out.mode, FollowerMode::kMeasurementLost);
+}
+
 TEST(FollowerCycle, TheMeasurementTriggerStepsOnMeasurementsAndBrakesOnTicks) {
   FollowerCycleSettings settings;
   settings.measurement_trigger = true;

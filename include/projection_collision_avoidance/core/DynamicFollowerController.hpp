@@ -79,6 +79,9 @@ class DynamicFollowerController {
                    FollowerController<DoubleIntegrator3D>, FollowerController<GenericDimensions>>;
 
   static Variant makeController(const ControllerDesign& design);
+  /// Runs @p call on the controller in use and copies its status into status_.
+  template <typename Call>
+  const DynamicFollowerStatus& visitStep(const Call& call);
 
   Variant controller_;
   DynamicFollowerStatus status_;

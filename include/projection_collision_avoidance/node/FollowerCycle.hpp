@@ -5,8 +5,8 @@
 #include <memory>
 #include <mutex>
 
-#include "projection_collision_avoidance/core/FollowerMode.hpp"
 #include "projection_collision_avoidance/core/DynamicFollowerController.hpp"
+#include "projection_collision_avoidance/core/FollowerMode.hpp"
 #include "projection_collision_avoidance/core/TypeDefs.hpp"
 #include "projection_collision_avoidance/rt/LatestValue.hpp"
 
@@ -95,7 +95,9 @@ struct FollowerCycleOutput {
 /// before now (after a jump back of ROS time, those of the old timeline are not, so the follower
 /// brakes until new ones arrive); its age counts from min(stamp, receipt). A tick more than half
 /// the measurement timeout late (a stalled process) starts a wait: ticks are skipped and counted
-/// as missed until a measurement arrives or half the timeout has passed.
+/// as missed until a measurement arrives or half the timeout has passed on the steady clock
+/// (simulated time can catch up by seconds within a millisecond when a stalled process resumes,
+/// before the measurements sent meanwhile are read).
 class FollowerCycle {
  public:
   /// @param controller the controller, moved in
@@ -113,11 +115,17 @@ class FollowerCycle {
   /// The slot the own odometry's callback writes (one writer thread; time headway only).
   LatestValue<OwnStateSample>& ownState() { return own_state_; }
 
-  /// A tick of the fixed-rate loop at ROS time @p now_ns, @p delay s after it was due, with
-  /// @p skipped periods skipped before it. Timer trigger: a step stamped now. Measurement
-  /// trigger: a braking step once the measurement is stale, else nothing.
+  /// A tick of the fixed-rate loop at ROS time @p now_ns and steady (monotonic) time
+  /// @p steady_ns, @p delay s after it was due, with @p skipped periods skipped before it. Timer
+  /// trigger: a step stamped now. Measurement trigger: a braking step once the measurement is
+  /// stale, else nothing.
   /// @return whether @p out got a step (out->stepped); the counters are filled either way
-  bool tick(std::int64_t now_ns, double delay, std::uint32_t skipped, FollowerCycleOutput* out);
+  bool tick(std::int64_t now_ns, std::int64_t steady_ns, double delay, std::uint32_t skipped,
+            FollowerCycleOutput* out);
+  /// tick() where ROS time is the steady clock (wall time that does not jump).
+  bool tick(std::int64_t now_ns, double delay, std::uint32_t skipped, FollowerCycleOutput* out) {
+    return tick(now_ns, now_ns, delay, skipped, out);
+  }
 
   /// The step answering the measurement just written to measurement() (measurement trigger),
   /// stamped with its stamp, at ROS time @p now_ns; @p skipped periods since the one before.
@@ -166,7 +174,7 @@ class FollowerCycle {
   std::uint32_t time_jumps_ = 0;
   double time_jump_ = 0.0;
   bool resuming_ = false;  ///< waiting for input after a stall
-  std::int64_t resumed_at_ns_ = 0;
+  std::int64_t resumed_at_steady_ns_ = 0;
   std::uint64_t sequence_at_stall_ = 0;
   double stall_ = 0.0;
 

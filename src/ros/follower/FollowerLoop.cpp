@@ -11,6 +11,16 @@
 #include "projection_collision_avoidance/ros/InputAdmission.hpp"
 
 namespace projection_collision_avoidance {
+namespace {
+
+/// CLOCK_MONOTONIC (ns), the clock of the real-time thread's ticks.
+std::int64_t steadyNanoseconds() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+}  // namespace
 
 FollowerLoop::FollowerLoop(ros::NodeHandle nh, std::string node_name,
                            const FollowerNodeOptions& options, double control_rate,
@@ -64,7 +74,7 @@ void FollowerLoop::onTimer(const ros::TimerEvent& event) {
       last_expected_ = event.current_expected;
       have_last_expected_ = true;
     }
-    cycle_->tick(nanosecondsOf(now), delay, skipped, &timer_output_);
+    cycle_->tick(nanosecondsOf(now), steadyNanoseconds(), delay, skipped, &timer_output_);
     outputs_->publish(timer_output_);
   } catch (const std::exception& error) {
     ROS_ERROR_STREAM_THROTTLE(5.0, name_ << ": control tick failed: " << error.what());
@@ -78,7 +88,7 @@ void FollowerLoop::onThreadTick(const PeriodicTick& tick) {
   try {
     const double delay = 1e-9 * static_cast<double>(tick.actual - tick.expected);
     const std::uint64_t most = std::numeric_limits<std::uint32_t>::max();
-    cycle_->tick(nanosecondsOf(ros::Time::now()), delay,
+    cycle_->tick(nanosecondsOf(ros::Time::now()), tick.actual, delay,
                  static_cast<std::uint32_t>(std::min(tick.skipped, most)), &thread_output_);
     outputs_->post(thread_output_);
   } catch (const std::exception& error) {

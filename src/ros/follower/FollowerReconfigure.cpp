@@ -4,15 +4,15 @@
 #include <utility>
 
 #include "projection_collision_avoidance/core/ControllerDesign.hpp"
-#include "projection_collision_avoidance/core/ParameterError.hpp"
 #include "projection_collision_avoidance/core/DynamicFollowerController.hpp"
+#include "projection_collision_avoidance/core/ParameterError.hpp"
 #include "projection_collision_avoidance/ros/RosParameters.hpp"
 
 namespace projection_collision_avoidance {
 
 FollowerReconfigure::FollowerReconfigure(ros::NodeHandle private_nh, std::string node_name,
-                                         const ControllerDesign& file_design,
-                                         FollowerCycle* cycle, FollowerOutputs* outputs)
+                                         const ControllerDesign& file_design, FollowerCycle* cycle,
+                                         FollowerOutputs* outputs)
     : name_(std::move(node_name)),
       file_parameters_(file_design.parameters),
       design_(file_design),

@@ -8,8 +8,8 @@
 #include <dynamic_reconfigure/server.h>
 #include <ros/ros.h>
 
-#include "projection_collision_avoidance/core/ControllerParameters.hpp"
 #include "projection_collision_avoidance/FollowerConfig.h"
+#include "projection_collision_avoidance/core/ControllerParameters.hpp"
 #include "projection_collision_avoidance/node/FollowerCycle.hpp"
 
 #include "follower/FollowerOutputs.hpp"
