@@ -64,42 +64,86 @@ TEST(ProjectionOperator, NeverPointsOutwardOnOrBeyondTheBoundary) {
   EXPECT_GT(active, 5000);  // the test exercised the projection, not only the pass-through
 }
 
+/// Trials of each LyapunovInequality* test below.
+constexpr int kLyapunovTrials = 20000;
+/// The least number of those trials in which the projection must act (change the drift) for the
+/// test to count: with xi_hat at f > 0 and h drawn symmetrically, grad_f^T h > 0 in about half of
+/// them (measured: 10056 of 20000 on or beyond the hard bound, 9909 of 20000 in the band, with
+/// the seeds below). A test whose trials all passed the drift through would check nothing.
+constexpr int kMinActiveLyapunovTrials = 8000;
+
+/// The projected drift of one trial, checked to equal h when the projection did not act and to
+/// differ from it when it did; @p active_count counts the latter.
+Eigen::VectorXd projectAndCount(const BallConstraint& ball, const Eigen::VectorXd& x,
+                                const Eigen::VectorXd& h, const Eigen::MatrixXd& gamma,
+                                int* active_count, bool* active) {
+  *active = false;
+  const Eigen::VectorXd rate = projectDrift(ball, x, h, Eigen::MatrixXd(gamma.inverse()), active);
+  if (*active) {
+    EXPECT_GT((rate - h).norm(), 0.0) << "reported active but the drift is unchanged";
+    ++*active_count;
+  } else {
+    EXPECT_MATRIX_NEAR(rate, h, 0.0);
+  }
+  return rate;
+}
+
 // Theorem 3.1's inequality (xi_hat - xi)^T Gamma (xi_hat' - h) <= 0 for xi inside Omega_1 and
-// xi_hat on or beyond the boundary.
+// xi_hat on or beyond the boundary. Where the projection does not act xi_hat' = h and the
+// inequality holds trivially (0 <= 0), so only the trials in which it acts count.
 TEST(ProjectionOperator, LyapunovInequalityForXiInsideTheHardBound) {
   std::mt19937 rng(2);
   const BallConstraint ball(kXiMax, kEpsilon);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
-  for (int trial = 0; trial < 20000; ++trial) {
+  int active = 0;
+  for (int trial = 0; trial < kLyapunovTrials; ++trial) {
     const int n = 1 + trial % 6;
     const Eigen::MatrixXd gamma = randomSpd(rng, n, 0.01, 100.0);
     const Eigen::VectorXd x = randomOnSphere(rng, n, kXiMax * (1.0 + 0.5 * unit(rng)));
     const Eigen::VectorXd xi = randomOnSphere(rng, n, kXiMax * unit(rng));
     const Eigen::VectorXd h = randomVector(rng, n, 10.0);
-    const Eigen::VectorXd rate =
-        projectDrift(ball, x, h, Eigen::MatrixXd(gamma.inverse()), nullptr);
+    bool acted = false;
+    const Eigen::VectorXd rate = projectAndCount(ball, x, h, gamma, &active, &acted);
+    if (!acted) {
+      continue;
+    }
     const double value = (x - xi).dot(gamma * (rate - h));
-    ASSERT_LE(value, 1e-9 * (1.0 + gamma.norm() * h.norm() * x.norm()));
+    ASSERT_LE(value, 1e-9 * (1.0 + gamma.norm() * h.norm() * x.norm()))
+        << "trial " << trial << " (active trial " << active << "), n=" << n
+        << " f=" << ball.value(x);
   }
+  RecordProperty("active_trials", active);
+  EXPECT_GE(active, kMinActiveLyapunovTrials)
+      << "the projection acted in " << active << " of " << kLyapunovTrials << " trials";
 }
 
 // Inside the soft band (0 < f < 1) the inequality holds for every xi in Omega_0 (Lavretsky &
-// Wise's hypothesis), and more generally whenever ||xi|| <= ||xi_hat||.
+// Wise's hypothesis), and more generally whenever ||xi|| <= ||xi_hat||. Only the trials in which
+// the projection acts count, as above.
 TEST(ProjectionOperator, LyapunovInequalityInTheBandForXiInsideTheSoftBound) {
   std::mt19937 rng(3);
   const BallConstraint ball(kXiMax, kEpsilon);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
-  for (int trial = 0; trial < 20000; ++trial) {
+  int active = 0;
+  for (int trial = 0; trial < kLyapunovTrials; ++trial) {
     const int n = 1 + trial % 6;
     const Eigen::MatrixXd gamma = randomSpd(rng, n, 0.01, 100.0);
     const double r = ball.softRadius() + (kXiMax - ball.softRadius()) * unit(rng);
     const Eigen::VectorXd x = randomOnSphere(rng, n, r);
     const Eigen::VectorXd xi = randomOnSphere(rng, n, r * unit(rng));
     const Eigen::VectorXd h = randomVector(rng, n, 10.0);
-    const Eigen::VectorXd rate =
-        projectDrift(ball, x, h, Eigen::MatrixXd(gamma.inverse()), nullptr);
-    ASSERT_LE((x - xi).dot(gamma * (rate - h)), 1e-9 * (1.0 + gamma.norm() * h.norm() * x.norm()));
+    bool acted = false;
+    const Eigen::VectorXd rate = projectAndCount(ball, x, h, gamma, &active, &acted);
+    if (!acted) {
+      continue;
+    }
+    ASSERT_LE((x - xi).dot(gamma * (rate - h)), 1e-9 * (1.0 + gamma.norm() * h.norm() * x.norm()))
+        << "trial " << trial << " (active trial " << active << "), n=" << n
+        << " f=" << ball.value(x);
   }
+  RecordProperty("active_trials", active);
+  EXPECT_GE(active, kMinActiveLyapunovTrials)
+      << "the projection acted in " << active << " of " << kLyapunovTrials << " trials";
 }
 
 // ... but not for every xi in Omega_1: with xi_hat in the band and xi farther out along the same
@@ -113,7 +157,10 @@ TEST(ProjectionOperator, LyapunovInequalityCanFailInTheBandForXiBetweenTheBounds
   const Eigen::VectorXd h = Eigen::Vector2d(1.0, 0.0);   // pointing outward
   ASSERT_GT(ball.value(x), 0.0);
   ASSERT_LT(ball.value(x), 1.0);
-  const Eigen::VectorXd rate = projectDrift(ball, x, h, gamma, nullptr);
+  bool active = false;
+  const Eigen::VectorXd rate = projectDrift(ball, x, h, gamma, &active);
+  ASSERT_TRUE(active) << "the projection must act for the counterexample to mean anything";
+  ASSERT_GT((rate - h).norm(), 0.0);
   EXPECT_GT((x - xi).dot(gamma * (rate - h)), 0.0);
 }
 

@@ -1,11 +1,13 @@
 #pragma once
 
 /// @file
-/// Fixture of the rostests: subscribes to what the follower publishes, and waits on conditions
-/// with wall-clock deadlines (never fixed sleeps).
+/// Fixtures and helpers of the rostests' C++ programs (their main() is rostest_main.cpp): the
+/// test node's parameters, waiting on conditions with wall-clock deadlines (never fixed sleeps),
+/// and what the follower publishes.
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <functional>
 #include <limits>
 #include <mutex>
@@ -19,9 +21,63 @@
 #include <visualization_msgs/MarkerArray.h>
 
 #include "projection_collision_avoidance/FollowerStatus.h"
+#include "projection_collision_avoidance/RelativeMeasurement.h"
 
 namespace projection_collision_avoidance {
 namespace testing {
+
+/// A <param> of the test node (read from @p private_nh, "~"), failing the test if it is missing.
+inline double requiredParam(const ros::NodeHandle& private_nh, const std::string& key) {
+  double value = 0.0;
+  EXPECT_TRUE(private_nh.getParam(key, value)) << "missing test parameter ~" << key;
+  return value;
+}
+
+/// The value of @p key in a diagnostic status, "(missing)" if it has none.
+inline std::string diagnosticValue(const diagnostic_msgs::DiagnosticStatus& status,
+                                   const std::string& key) {
+  for (const auto& entry : status.values) {
+    if (entry.key == key) {
+      return entry.value;
+    }
+  }
+  return "(missing)";
+}
+
+/// A valid 1-axis relative measurement in the world frame, stamped now.
+inline RelativeMeasurement measurementNow(double position, double velocity) {
+  RelativeMeasurement msg;
+  msg.header.frame_id = "world";
+  msg.header.stamp = ros::Time::now();
+  msg.position = {position};
+  msg.velocity = {velocity};
+  return msg;
+}
+
+/// What the tests of the follower's steps keep of a status.
+struct StatusSample {
+  ros::Time stamp;
+  std::uint64_t ticks = 0;
+  std::uint32_t missed_periods = 0;
+  std::uint32_t late_periods = 0;
+  double tick_delay = 0.0;
+  std::uint8_t mode = 0;
+  bool fallback = false;
+  std::vector<double> command;
+};
+
+inline StatusSample sampleOf(const FollowerStatus& msg) {
+  StatusSample sample;
+  sample.stamp = msg.header.stamp;
+  sample.ticks = msg.ticks;
+  sample.missed_periods = msg.missed_periods;
+  sample.late_periods = msg.late_periods;
+  sample.tick_delay = msg.tick_delay;
+  sample.mode = msg.mode;
+  sample.fallback = msg.fallback != 0;
+  sample.command = msg.command;
+  return sample;
+}
 
 /// Figures of the follower's status stream since the fixture started.
 struct StatusRecord {
@@ -63,16 +119,13 @@ inline void addStatus(const FollowerStatus& msg, StatusRecord* record) {
   record->last = msg;
 }
 
-class FollowerTest : public ::testing::Test {
+/// The test node's handles and parameters, and waiting with a deadline: the base of the fixtures.
+class RosTestFixture : public ::testing::Test {
  protected:
-  FollowerTest() : private_nh_("~") {
-    status_subscriber_ = nh_.subscribe("/follower/status", 1000, &FollowerTest::onStatus, this);
-    marker_subscriber_ = nh_.subscribe("/follower/markers", 10, &FollowerTest::onMarkers, this);
-    diagnostics_subscriber_ =
-        nh_.subscribe("/diagnostics", 100, &FollowerTest::onDiagnostics, this);
-  }
+  RosTestFixture() : private_nh_("~") {}
 
-  /// Spins until @p condition holds or @p wall_seconds pass; returns whether it held.
+  /// Spins until @p condition (called with mutex_ held) holds or @p wall_seconds pass; returns
+  /// whether it held.
   bool waitFor(const std::function<bool()>& condition, double wall_seconds) {
     const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(wall_seconds);
     while (ros::ok() && ros::WallTime::now() < deadline) {
@@ -89,6 +142,24 @@ class FollowerTest : public ::testing::Test {
     return condition();
   }
 
+  /// A <param> of the test node, failing the test if it is missing.
+  double param(const std::string& key) { return requiredParam(private_nh_, key); }
+
+  ros::NodeHandle nh_;
+  ros::NodeHandle private_nh_;
+  std::mutex mutex_;  ///< guards what the subscribers' callbacks write
+};
+
+/// Subscribes to what the follower (/follower) publishes: status, markers, diagnostics.
+class FollowerTest : public RosTestFixture {
+ protected:
+  FollowerTest() {
+    status_subscriber_ = nh_.subscribe("/follower/status", 1000, &FollowerTest::onStatus, this);
+    marker_subscriber_ = nh_.subscribe("/follower/markers", 10, &FollowerTest::onMarkers, this);
+    diagnostics_subscriber_ =
+        nh_.subscribe("/diagnostics", 100, &FollowerTest::onDiagnostics, this);
+  }
+
   /// Waits until a status stamped at or after @p sim_seconds has arrived.
   bool waitForStatusTime(double sim_seconds, double wall_seconds) {
     return waitFor([this, sim_seconds] { return record_.last_time >= sim_seconds; }, wall_seconds);
@@ -99,16 +170,6 @@ class FollowerTest : public ::testing::Test {
     return record_;
   }
 
-  /// A <param> of the test node, failing the test if it is missing.
-  double param(const std::string& key) {
-    double value = 0.0;
-    EXPECT_TRUE(private_nh_.getParam(key, value)) << "missing test parameter ~" << key;
-    return value;
-  }
-
-  ros::NodeHandle nh_;
-  ros::NodeHandle private_nh_;
-  std::mutex mutex_;
   StatusRecord record_;
   visualization_msgs::MarkerArray markers_;
   bool have_markers_ = false;

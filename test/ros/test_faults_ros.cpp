@@ -214,9 +214,3 @@ TEST_F(FaultTest, FollowerRespawn) {
 
 }  // namespace
 }  // namespace projection_collision_avoidance
-
-int main(int argc, char** argv) {
-  ::testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "test_faults_ros");
-  return RUN_ALL_TESTS();
-}

@@ -152,20 +152,11 @@ TEST_F(FollowerTest, ReconfigureSwitchesTheTrackerAndRefusesAnInvalidAlpha) {
   EXPECT_TRUE(waitFor([this] { return std::abs(record_.last.xi_max - 3.5) < 1e-12; }, deadline));
 }
 
-/// The tracker gain the follower's diagnostics report, "" before they do.
-std::string trackerGainOf(const diagnostic_msgs::DiagnosticStatus& status) {
-  for (const auto& value : status.values) {
-    if (value.key == "tracker_gain") {
-      return value.value;
-    }
-  }
-  return "";
-}
-
 TEST_F(FollowerTest, ReconfigureFrequencyZeroRestoresTheFilesGainAndNeverStoresNonFinite) {
   const double deadline = param("wall_deadline");
   const auto gain_is = [this](const std::string& gain) {  // called by waitFor() with mutex_ held
-    return !follower_diagnostics_.empty() && trackerGainOf(follower_diagnostics_.back()) == gain;
+    return !follower_diagnostics_.empty() &&
+           testing::diagnosticValue(follower_diagnostics_.back(), "tracker_gain") == gain;
   };
   // Run 2's G_e = [10, 5]; (omega_n, zeta) = (2, 0.7) gives [omega_n^2, 2 zeta omega_n].
   ASSERT_TRUE(waitFor([&] { return gain_is("[10, 5]"); }, deadline));
@@ -198,9 +189,3 @@ TEST_F(FollowerTest, ReconfigureFrequencyZeroRestoresTheFilesGainAndNeverStoresN
 
 }  // namespace
 }  // namespace projection_collision_avoidance
-
-int main(int argc, char** argv) {
-  ::testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "test_follower_interfaces");
-  return RUN_ALL_TESTS();
-}

@@ -62,11 +62,7 @@ class MeasurementSource {
 
  private:
   void publish() {
-    RelativeMeasurement msg;
-    msg.header.frame_id = "world";
-    msg.header.stamp = ros::Time::now();
-    msg.position = {5.5};
-    msg.velocity = {0.1};
+    const RelativeMeasurement msg = testing::measurementNow(5.5, 0.1);
     for (const ros::Publisher& publisher : publishers_) {
       publisher.publish(msg);
     }
@@ -81,21 +77,30 @@ class MeasurementSource {
 
 std::unique_ptr<MeasurementSource> g_source;
 
-/// What the test keeps of a status.
-struct StatusSample {
-  ros::Time stamp;
-  std::uint64_t ticks = 0;
-  std::uint32_t missed_periods = 0;
-  std::uint32_t late_periods = 0;
-  double tick_delay = 0.0;
-  std::uint8_t mode = 0;
-  std::vector<double> command;
+/// Starts the measurement source once ros::init has run (rostest_main.cpp) and before the
+/// first test, and stops it after the last: a gap between the tests would put the followers in
+/// the fallback at different steps. Without a positive ~measurement_rate no test runs.
+class MeasurementSourceEnvironment : public ::testing::Environment {
+ public:
+  void SetUp() override {
+    ros::NodeHandle private_nh("~");
+    double rate = 0.0;
+    if (!private_nh.getParam("measurement_rate", rate) || !(rate > 0.0)) {
+      ROS_FATAL("test_follower_loop: ~measurement_rate missing or not positive");
+      GTEST_FAIL() << "~measurement_rate missing or not positive";
+    }
+    g_source = std::make_unique<MeasurementSource>(rate);
+  }
+
+  void TearDown() override { g_source.reset(); }
 };
 
-StatusSample sampleOf(const FollowerStatus& msg) {
-  return StatusSample{msg.header.stamp, msg.ticks, msg.missed_periods, msg.late_periods,
-                      msg.tick_delay,   msg.mode,  msg.command};
-}
+// gtest owns the environment.
+::testing::Environment* const g_source_environment =
+    ::testing::AddGlobalTestEnvironment(new MeasurementSourceEnvironment);
+
+using testing::sampleOf;
+using testing::StatusSample;
 
 class FollowerLoopTest : public testing::FollowerTest {
  protected:
@@ -237,14 +242,7 @@ TEST_F(FollowerLoopTest, SameCommandsAsTheTimerLoopAtEveryStep) {
 
 TEST_F(FollowerLoopTest, DiagnosticsNameTheLoop) {
   ASSERT_TRUE(connected()) << "the followers and the test never connected";
-  const auto value = [](const diagnostic_msgs::DiagnosticStatus& status, const std::string& key) {
-    for (const auto& entry : status.values) {
-      if (entry.key == key) {
-        return entry.value;
-      }
-    }
-    return std::string("(missing)");
-  };
+  const auto value = &testing::diagnosticValue;
   const auto reported = [&](const std::string& node, const std::string& loop) {
     return std::any_of(follower_diagnostics_.begin(), follower_diagnostics_.end(),
                        [&](const diagnostic_msgs::DiagnosticStatus& status) {
@@ -262,21 +260,3 @@ TEST_F(FollowerLoopTest, DiagnosticsNameTheLoop) {
 
 }  // namespace
 }  // namespace projection_collision_avoidance
-
-int main(int argc, char** argv) {
-  ::testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "test_follower_loop");
-  ros::NodeHandle private_nh("~");
-  double rate = 0.0;
-  if (!private_nh.getParam("measurement_rate", rate) || !(rate > 0.0)) {
-    ROS_FATAL("test_follower_loop: ~measurement_rate missing or not positive");
-    return 1;
-  }
-  // Measurements from the start to the end of the process: a gap between the tests would put
-  // the followers in the fallback at different steps.
-  projection_collision_avoidance::g_source =
-      std::make_unique<projection_collision_avoidance::MeasurementSource>(rate);
-  const int result = RUN_ALL_TESTS();
-  projection_collision_avoidance::g_source.reset();
-  return result;
-}

@@ -24,14 +24,7 @@
 namespace projection_collision_avoidance {
 namespace {
 
-/// What the test keeps of a status.
-struct StatusSample {
-  ros::Time stamp;
-  std::uint64_t ticks = 0;
-  std::uint8_t mode = 0;
-  bool fallback = false;
-  double tick_delay = 0.0;
-};
+using testing::StatusSample;
 
 class FollowerTriggerTest : public testing::FollowerTest {
  protected:
@@ -55,11 +48,7 @@ class FollowerTriggerTest : public testing::FollowerTest {
 
   /// Publishes one valid measurement stamped now; returns the stamp.
   ros::Time publishMeasurement() {
-    RelativeMeasurement msg;
-    msg.header.frame_id = "world";
-    msg.header.stamp = ros::Time::now();
-    msg.position = {5.5};
-    msg.velocity = {0.1};
+    const RelativeMeasurement msg = testing::measurementNow(5.5, 0.1);
     publisher_.publish(msg);
     return msg.header.stamp;
   }
@@ -91,8 +80,7 @@ class FollowerTriggerTest : public testing::FollowerTest {
 
   void onStatus(const FollowerStatus::ConstPtr& msg) {
     const std::lock_guard<std::mutex> lock(mutex_);
-    statuses_.push_back(StatusSample{msg->header.stamp, msg->ticks, msg->mode, msg->fallback != 0,
-                                     msg->tick_delay});
+    statuses_.push_back(testing::sampleOf(*msg));
   }
 
   ros::Subscriber command_subscriber_;
@@ -182,14 +170,7 @@ TEST_F(FollowerTriggerTest, DiagnosticsNameTheTriggerAndTheLoop) {
   ASSERT_TRUE(connected()) << "the follower and the test never connected";
   std::string loop;
   ASSERT_TRUE(private_nh_.getParam("control_loop", loop)) << "missing test parameter ~control_loop";
-  const auto value = [](const diagnostic_msgs::DiagnosticStatus& status, const std::string& key) {
-    for (const auto& entry : status.values) {
-      if (entry.key == key) {
-        return entry.value;
-      }
-    }
-    return std::string("(missing)");
-  };
+  const auto value = &testing::diagnosticValue;
   EXPECT_TRUE(waitFor(
       [&] {
         return std::any_of(follower_diagnostics_.begin(), follower_diagnostics_.end(),
@@ -204,9 +185,3 @@ TEST_F(FollowerTriggerTest, DiagnosticsNameTheTriggerAndTheLoop) {
 
 }  // namespace
 }  // namespace projection_collision_avoidance
-
-int main(int argc, char** argv) {
-  ::testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "test_follower_trigger");
-  return RUN_ALL_TESTS();
-}

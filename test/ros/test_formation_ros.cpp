@@ -47,9 +47,9 @@ struct AgentRecord {
   std::map<ros::Time, Eigen::VectorXd> positions;  ///< odometry positions by stamp
 };
 
-class FormationTest : public ::testing::Test {
+class FormationTest : public testing::RosTestFixture {
  protected:
-  FormationTest() : private_nh_("~") {
+  FormationTest() {
     scenario_ = loadScenarioParameter(private_nh_);
     members_ = layoutFormation(scenario_.formation, scenario_.controller.separation,
                                scenario_.leader_initial_state, scenario_.follower_initial_state);
@@ -74,37 +74,22 @@ class FormationTest : public ::testing::Test {
     }
   }
 
-  double param(const std::string& key) {
-    double value = 0.0;
-    EXPECT_TRUE(private_nh_.getParam(key, value)) << "missing test parameter ~" << key;
-    return value;
-  }
-
   /// Spins until every follower has a status stamped at or after @p sim_seconds.
   bool waitForAll(double sim_seconds, double wall_seconds) {
-    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(wall_seconds);
-    while (ros::ok() && ros::WallTime::now() < deadline) {
-      ros::spinOnce();
-      {
-        const std::lock_guard<std::mutex> lock(mutex_);
-        bool all = true;
-        for (std::size_t a = 1; a < agents_.size(); ++a) {
-          all = all && agents_[a].status.last_time >= sim_seconds;
-        }
-        if (all) {
+    return waitFor(
+        [this, sim_seconds] {
+          for (std::size_t a = 1; a < agents_.size(); ++a) {
+            if (agents_[a].status.last_time < sim_seconds) {
+              return false;
+            }
+          }
           return true;
-        }
-      }
-      ros::WallDuration(0.002).sleep();
-    }
-    return false;
+        },
+        wall_seconds);
   }
 
-  ros::NodeHandle nh_;
-  ros::NodeHandle private_nh_;
   Scenario scenario_;
   std::vector<FormationMember> members_;
-  std::mutex mutex_;
 
   /// min ||p_target - p_i|| over the plant ticks at which both odometries arrived (m), and the
   /// number of such ticks.
@@ -207,9 +192,3 @@ TEST_F(FormationTest, EveryFollowerHoldsItsSlotAsCfSimDoes) {
 
 }  // namespace
 }  // namespace projection_collision_avoidance
-
-int main(int argc, char** argv) {
-  ::testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "test_formation_ros");
-  return RUN_ALL_TESTS();
-}

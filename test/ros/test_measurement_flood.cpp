@@ -19,21 +19,17 @@
 #include "projection_collision_avoidance/FollowerStatus.h"
 #include "projection_collision_avoidance/RelativeMeasurement.h"
 
+#include "test_common.h"
+
 namespace projection_collision_avoidance {
 namespace {
-
-double param(const ros::NodeHandle& nh, const std::string& key) {
-  double value = 0.0;
-  EXPECT_TRUE(nh.getParam(key, value)) << "missing test parameter ~" << key;
-  return value;
-}
 
 TEST(MeasurementFlood, ControlTimerKeepsItsRate) {
   ros::NodeHandle nh;
   ros::NodeHandle private_nh("~");
-  const double flood_rate = param(private_nh, "flood_rate");
-  const double flood_seconds = param(private_nh, "flood_seconds");
-  const double control_rate = param(private_nh, "control_rate");
+  const double flood_rate = testing::requiredParam(private_nh, "flood_rate");
+  const double flood_seconds = testing::requiredParam(private_nh, "flood_seconds");
+  const double control_rate = testing::requiredParam(private_nh, "control_rate");
 
   std::mutex mutex;
   std::vector<ros::Time> arrivals;  // tick times (stamps, wall clock here) of the statuses
@@ -113,18 +109,12 @@ TEST(MeasurementFlood, ControlTimerKeepsItsRate) {
       "flood: %ld measurements in %.2f s (%.0f Hz); follower statuses %.1f Hz, largest gap "
       "%.4f s (control rate %.0f Hz)",
       published, elapsed, flood_achieved, status_rate, max_gap, control_rate);
-  EXPECT_GE(flood_achieved, param(private_nh, "min_flood_share") * flood_rate);
-  EXPECT_GE(status_rate, param(private_nh, "min_rate_share") * control_rate);
-  EXPECT_LE(max_gap, param(private_nh, "max_status_gap"));
+  EXPECT_GE(flood_achieved, testing::requiredParam(private_nh, "min_flood_share") * flood_rate);
+  EXPECT_GE(status_rate, testing::requiredParam(private_nh, "min_rate_share") * control_rate);
+  EXPECT_LE(max_gap, testing::requiredParam(private_nh, "max_status_gap"));
   const std::lock_guard<std::mutex> lock(mutex);
   EXPECT_EQ(last.mode, FollowerStatus::MODE_TRACKING) << last.mode_name;
 }
 
 }  // namespace
 }  // namespace projection_collision_avoidance
-
-int main(int argc, char** argv) {
-  ::testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "test_measurement_flood");
-  return RUN_ALL_TESTS();
-}

@@ -53,9 +53,3 @@ TEST_F(FollowerTest, PaperRunThroughTheRosGraph) {
 
 }  // namespace
 }  // namespace projection_collision_avoidance
-
-int main(int argc, char** argv) {
-  ::testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "test_paper_run_ros");
-  return RUN_ALL_TESTS();
-}
