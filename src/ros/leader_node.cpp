@@ -1,5 +1,5 @@
 #include "projection_collision_avoidance/ros/LeaderNode.hpp"
-#include "projection_collision_avoidance/ros/NodeMain.hpp"
+#include "NodeMain.hpp"
 
 int main(int argc, char** argv) {
   return projection_collision_avoidance::runNode<projection_collision_avoidance::LeaderNode>(

@@ -1,4 +1,4 @@
-#include "projection_collision_avoidance/ros/NodeMain.hpp"
+#include "NodeMain.hpp"
 #include "projection_collision_avoidance/ros/PlantNode.hpp"
 
 int main(int argc, char** argv) {
