@@ -7,7 +7,7 @@
 #          [--runs N] [--duration S] [--reps R]
 #   BEFORE_BUILD, AFTER_BUILD  standalone build directories (scripts/build.sh with BUILD_DIR),
 #                              each built from its own checkout
-#   --runs 2  --duration 30  --reps 5
+#   --runs 2  --duration 30  --reps 5  --report-only (the tables from OUT's figures)
 # Timing-sensitive: run it on a quiet machine; the control-thread setting needs root.
 set -euo pipefail
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
@@ -20,16 +20,19 @@ shift 3
 runs=2
 duration=30
 reps=5
+report_only=0
 while [ $# -gt 0 ]; do
   case $1 in
     --runs) runs=$2; shift 2 ;;
     --duration) duration=$2; shift 2 ;;
     --reps) reps=$2; shift 2 ;;
+    --report-only) report_only=1; shift ;;
     *) echo "before_after: unknown argument $1" >&2; exit 2 ;;
   esac
 done
 mkdir -p "$out"
 
+if [ "$report_only" = 0 ]; then
 for i in 0 1; do
   bin=${builds[$i]}/devel/lib/projection_collision_avoidance
   "$bin/benchmark_follower_step" --benchmark_repetitions="$reps" \
@@ -43,20 +46,22 @@ for run in $(seq 1 "$runs"); do
       --csv "$out/${labels[$i]}_latency_$run.csv" >"$out/${labels[$i]}_latency_$run.md"
   done
 done
+fi
 
 /usr/bin/python3 - "$out" "$runs" <<'EOF'
 import csv, json, statistics, sys
 out, runs = sys.argv[1], int(sys.argv[2])
 def bench(label):
     data = json.load(open(f"{out}/{label}_benchmark.json"))
-    return {b["run_name"]: b["real_time"] for b in data["benchmarks"]
+    return {b["run_name"]: (b["real_time"], b["time_unit"]) for b in data["benchmarks"]
             if b.get("aggregate_name") == "median"}
 before, after = bench("before"), bench("after")
-print("| control step (median) | before (ns) | after (ns) | after / before |")
+print("| benchmark (median) | before | after | after / before |")
 print("|---|---|---|---|")
-for name in before:
+for name, (b, unit) in before.items():
     if name in after:
-        print(f"| `{name}` | {before[name]:.0f} | {after[name]:.0f} | {after[name] / before[name]:.3f} |")
+        a = after[name][0]
+        print(f"| `{name}` | {b:.4g} {unit} | {a:.4g} {after[name][1]} | {a / b:.3f} |")
 print()
 rows = {}
 for label in ("before", "after"):
