@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Two builds side by side (e.g. the commit before a change and after it): the control step of
-# Google Benchmark (median of REPS repetitions, per benchmark) and the ROS follower at 1 kHz
+# Google Benchmark (median of REPS runs, the builds in turn) and the ROS follower at 1 kHz
 # (experiments/ros_latency/run.sh: keep-awake, and the real-time control thread), the builds
 # measured in turn, run by run. Prints Markdown tables; raw figures go to OUT.
 # Usage: experiments/performance/before_after.sh BEFORE_BUILD AFTER_BUILD OUT
@@ -33,11 +33,14 @@ done
 mkdir -p "$out"
 
 if [ "$report_only" = 0 ]; then
-for i in 0 1; do
-  bin=${builds[$i]}/devel/lib/projection_collision_avoidance
-  "$bin/benchmark_follower_step" --benchmark_repetitions="$reps" \
-    --benchmark_report_aggregates_only=true --benchmark_format=json \
-    >"$out/${labels[$i]}_benchmark.json"
+# The two builds' benchmarks in turn, one repetition each, REPS times: a machine that drifts
+# (frequency, other load) moves both alike.
+for rep in $(seq 1 "$reps"); do
+  for i in 0 1; do
+    bin=${builds[$i]}/devel/lib/projection_collision_avoidance
+    "$bin/benchmark_follower_step" --benchmark_format=json \
+      >"$out/${labels[$i]}_benchmark_$rep.json"
+  done
 done
 for run in $(seq 1 "$runs"); do
   for i in 0 1; do
@@ -48,15 +51,17 @@ for run in $(seq 1 "$runs"); do
 done
 fi
 
-/usr/bin/python3 - "$out" "$runs" <<'EOF'
-import csv, json, statistics, sys
+/usr/bin/python3 - "$out" "$runs" "$reps" <<'EOF'
+import csv, glob, json, statistics, sys
 out, runs = sys.argv[1], int(sys.argv[2])
 def bench(label):
-    data = json.load(open(f"{out}/{label}_benchmark.json"))
-    return {b["run_name"]: (b["real_time"], b["time_unit"]) for b in data["benchmarks"]
-            if b.get("aggregate_name") == "median"}
+    times = {}
+    for path in sorted(glob.glob(f"{out}/{label}_benchmark_*.json")):
+        for b in json.load(open(path))["benchmarks"]:
+            times.setdefault(b["run_name"], ([], b["time_unit"]))[0].append(b["real_time"])
+    return {name: (statistics.median(t), unit) for name, (t, unit) in times.items()}
 before, after = bench("before"), bench("after")
-print("| benchmark (median) | before | after | after / before |")
+print(f"| benchmark (median of {sys.argv[3]}, in turn) | before | after | after / before |")
 print("|---|---|---|---|")
 for name, (b, unit) in before.items():
     if name in after:
