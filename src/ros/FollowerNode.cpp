@@ -4,8 +4,8 @@
 #include <system_error>
 
 #include "projection_collision_avoidance/core/ControllerDesign.hpp"
-#include "projection_collision_avoidance/core/ParameterError.hpp"
 #include "projection_collision_avoidance/core/DynamicFollowerController.hpp"
+#include "projection_collision_avoidance/core/ParameterError.hpp"
 #include "projection_collision_avoidance/node/FollowerCycle.hpp"
 #include "projection_collision_avoidance/ros/RosParameters.hpp"
 

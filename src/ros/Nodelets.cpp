@@ -8,11 +8,11 @@
 #include <pluginlib/class_list_macros.hpp>
 
 #include "projection_collision_avoidance/core/ParameterError.hpp"
-#include "projection_collision_avoidance/scenario/ScenarioLoader.hpp"
 #include "projection_collision_avoidance/ros/FollowerNode.hpp"
 #include "projection_collision_avoidance/ros/LeaderNode.hpp"
 #include "projection_collision_avoidance/ros/LinkRelay.hpp"
 #include "projection_collision_avoidance/ros/PlantNode.hpp"
+#include "projection_collision_avoidance/scenario/ScenarioLoader.hpp"
 
 namespace projection_collision_avoidance {
 

@@ -1,4 +1,5 @@
 #include "projection_collision_avoidance/ros/FollowerNode.hpp"
+
 #include "NodeMain.hpp"
 
 int main(int argc, char** argv) {

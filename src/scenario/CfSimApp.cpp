@@ -13,11 +13,11 @@
 #include <string>
 #include <vector>
 
-#include "projection_collision_avoidance/sim/SampledSimulator.hpp"
-#include "projection_collision_avoidance/sim/ContinuousSimulator.hpp"
-#include "projection_collision_avoidance/sim/DisturbanceSweep.hpp"
 #include "projection_collision_avoidance/core/ParameterError.hpp"
 #include "projection_collision_avoidance/scenario/ScenarioLoader.hpp"
+#include "projection_collision_avoidance/sim/ContinuousSimulator.hpp"
+#include "projection_collision_avoidance/sim/DisturbanceSweep.hpp"
+#include "projection_collision_avoidance/sim/SampledSimulator.hpp"
 #include "projection_collision_avoidance/sim/SimulationCsvWriter.hpp"
 #include "projection_collision_avoidance/sim/StringStability.hpp"
 

@@ -7,11 +7,11 @@
 #include <string>
 #include <vector>
 
-#include "projection_collision_avoidance/sim/ContinuousDynamics.hpp"
 #include "projection_collision_avoidance/core/ControllerDesign.hpp"
 #include "projection_collision_avoidance/core/DimensionDispatch.hpp"
 #include "projection_collision_avoidance/core/Formation.hpp"
 #include "projection_collision_avoidance/core/ParameterError.hpp"
+#include "projection_collision_avoidance/sim/ContinuousDynamics.hpp"
 
 namespace projection_collision_avoidance {
 namespace {

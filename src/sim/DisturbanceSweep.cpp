@@ -3,8 +3,8 @@
 #include <cmath>
 #include <string>
 
-#include "projection_collision_avoidance/sim/SampledSimulator.hpp"
 #include "projection_collision_avoidance/core/ParameterError.hpp"
+#include "projection_collision_avoidance/sim/SampledSimulator.hpp"
 
 namespace projection_collision_avoidance {
 namespace {

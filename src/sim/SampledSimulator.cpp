@@ -9,12 +9,12 @@
 #include <string>
 #include <vector>
 
-#include "projection_collision_avoidance/sim/AgentIntegrator.hpp"
 #include "projection_collision_avoidance/core/ControllerDesign.hpp"
 #include "projection_collision_avoidance/core/DimensionDispatch.hpp"
 #include "projection_collision_avoidance/core/FollowerController.hpp"
 #include "projection_collision_avoidance/core/PaperLaws.hpp"
 #include "projection_collision_avoidance/core/ParameterError.hpp"
+#include "projection_collision_avoidance/sim/AgentIntegrator.hpp"
 #include "projection_collision_avoidance/sim/SharedLink.hpp"
 
 namespace projection_collision_avoidance {

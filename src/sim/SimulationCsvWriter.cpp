@@ -56,8 +56,9 @@ void SimulationCsvWriter::write(const SimulationSample& s) {
   out_ << s.time;
   writeValues(out_, s.relative_error, states_);
   writeValues(out_, s.controller.estimate, states_);
-  out_ << ',' << s.relative_error.norm() << ',' << s.controller.estimate.norm() << ',' << xi_max_ << ','
-       << xi_soft_ << ',' << s.controller.constraint_value << ',' << (s.controller.projection_active ? 1 : 0);
+  out_ << ',' << s.relative_error.norm() << ',' << s.controller.estimate.norm() << ',' << xi_max_
+       << ',' << xi_soft_ << ',' << s.controller.constraint_value << ','
+       << (s.controller.projection_active ? 1 : 0);
   writeValues(out_, s.leader_state, positions_);
   writeValues(out_, s.follower_state, positions_);
   if (velocities_) {

@@ -9,12 +9,12 @@
 
 #include <benchmark/benchmark.h>
 
-#include "projection_collision_avoidance/sim/SampledSimulator.hpp"
-#include "projection_collision_avoidance/sim/ContinuousSimulator.hpp"
 #include "projection_collision_avoidance/core/ControllerDesign.hpp"
 #include "projection_collision_avoidance/core/FollowerController.hpp"
-#include "projection_collision_avoidance/sim/ScenarioEmbedding.hpp"
 #include "projection_collision_avoidance/scenario/ScenarioLoader.hpp"
+#include "projection_collision_avoidance/sim/ContinuousSimulator.hpp"
+#include "projection_collision_avoidance/sim/SampledSimulator.hpp"
+#include "projection_collision_avoidance/sim/ScenarioEmbedding.hpp"
 
 #include "AllocationCounter.hpp"
 #include "StepFlops.hpp"

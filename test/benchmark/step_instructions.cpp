@@ -9,8 +9,8 @@
 
 #include "projection_collision_avoidance/core/ControllerDesign.hpp"
 #include "projection_collision_avoidance/core/FollowerController.hpp"
-#include "projection_collision_avoidance/sim/ScenarioEmbedding.hpp"
 #include "projection_collision_avoidance/scenario/ScenarioLoader.hpp"
+#include "projection_collision_avoidance/sim/ScenarioEmbedding.hpp"
 
 namespace projection_collision_avoidance {
 namespace {

@@ -8,8 +8,8 @@
 #include <Eigen/Core>
 #include <gtest/gtest.h>
 
-#include "projection_collision_avoidance/sim/AgentIntegrator.hpp"
 #include "projection_collision_avoidance/core/AgentModel.hpp"
+#include "projection_collision_avoidance/sim/AgentIntegrator.hpp"
 #include "projection_collision_avoidance/sim/SignalProfile.hpp"
 
 #include "EigenTestHelpers.hpp"

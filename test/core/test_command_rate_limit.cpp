@@ -10,9 +10,9 @@
 
 #include "projection_collision_avoidance/core/CommandRateLimiter.hpp"
 #include "projection_collision_avoidance/core/ControllerDesign.hpp"
+#include "projection_collision_avoidance/core/DynamicFollowerController.hpp"
 #include "projection_collision_avoidance/core/FollowerController.hpp"
 #include "projection_collision_avoidance/core/ParameterError.hpp"
-#include "projection_collision_avoidance/core/DynamicFollowerController.hpp"
 #include "projection_collision_avoidance/scenario/ScenarioLoader.hpp"
 
 #include "EigenTestHelpers.hpp"

@@ -8,12 +8,12 @@
 
 #include <gtest/gtest.h>
 
-#include "projection_collision_avoidance/sim/SampledSimulator.hpp"
+#include "projection_collision_avoidance/core/ParameterError.hpp"
+#include "projection_collision_avoidance/scenario/ScenarioLoader.hpp"
 #include "projection_collision_avoidance/sim/ContinuousDynamics.hpp"
 #include "projection_collision_avoidance/sim/ContinuousSimulator.hpp"
-#include "projection_collision_avoidance/core/ParameterError.hpp"
+#include "projection_collision_avoidance/sim/SampledSimulator.hpp"
 #include "projection_collision_avoidance/sim/ScenarioEmbedding.hpp"
-#include "projection_collision_avoidance/scenario/ScenarioLoader.hpp"
 
 #include "TestScenarios.hpp"
 

@@ -12,8 +12,8 @@
 #include "projection_collision_avoidance/core/BallConstraint.hpp"
 #include "projection_collision_avoidance/core/CollisionFreeEstimator.hpp"
 #include "projection_collision_avoidance/core/ControllerDesign.hpp"
-#include "projection_collision_avoidance/core/FollowerController.hpp"
 #include "projection_collision_avoidance/core/DynamicFollowerController.hpp"
+#include "projection_collision_avoidance/core/FollowerController.hpp"
 
 #include "EigenTestHelpers.hpp"
 #include "TestScenarios.hpp"

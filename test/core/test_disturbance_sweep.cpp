@@ -6,10 +6,10 @@
 
 #include <gtest/gtest.h>
 
-#include "projection_collision_avoidance/sim/SampledSimulator.hpp"
-#include "projection_collision_avoidance/sim/DisturbanceSweep.hpp"
 #include "projection_collision_avoidance/core/ParameterError.hpp"
 #include "projection_collision_avoidance/scenario/ScenarioLoader.hpp"
+#include "projection_collision_avoidance/sim/DisturbanceSweep.hpp"
+#include "projection_collision_avoidance/sim/SampledSimulator.hpp"
 
 #include "EigenTestHelpers.hpp"
 #include "TestScenarios.hpp"

@@ -6,9 +6,9 @@
 #include <gtest/gtest.h>
 #include <unsupported/Eigen/MatrixFunctions>
 
-#include "projection_collision_avoidance/sim/SampledSimulator.hpp"
 #include "projection_collision_avoidance/core/ControllerDesign.hpp"
 #include "projection_collision_avoidance/core/FollowerController.hpp"
+#include "projection_collision_avoidance/sim/SampledSimulator.hpp"
 
 #include "EigenTestHelpers.hpp"
 #include "TestScenarios.hpp"

@@ -7,10 +7,10 @@
 #include <gtest/gtest.h>
 
 #include "projection_collision_avoidance/core/ControllerDesign.hpp"
+#include "projection_collision_avoidance/core/DynamicFollowerController.hpp"
 #include "projection_collision_avoidance/core/FollowerController.hpp"
 #include "projection_collision_avoidance/core/FollowerMode.hpp"
 #include "projection_collision_avoidance/core/ParameterError.hpp"
-#include "projection_collision_avoidance/core/DynamicFollowerController.hpp"
 #include "projection_collision_avoidance/scenario/ScenarioLoader.hpp"
 
 #include "EigenTestHelpers.hpp"

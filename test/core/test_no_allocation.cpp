@@ -7,12 +7,12 @@
 #include <Eigen/Core>
 #include <gtest/gtest.h>
 
-#include "projection_collision_avoidance/sim/AgentIntegrator.hpp"
-#include "projection_collision_avoidance/sim/SampledSimulator.hpp"
-#include "projection_collision_avoidance/sim/ContinuousDynamics.hpp"
 #include "projection_collision_avoidance/core/ControllerDesign.hpp"
-#include "projection_collision_avoidance/core/FollowerController.hpp"
 #include "projection_collision_avoidance/core/DynamicFollowerController.hpp"
+#include "projection_collision_avoidance/core/FollowerController.hpp"
+#include "projection_collision_avoidance/sim/AgentIntegrator.hpp"
+#include "projection_collision_avoidance/sim/ContinuousDynamics.hpp"
+#include "projection_collision_avoidance/sim/SampledSimulator.hpp"
 #include "projection_collision_avoidance/sim/ScenarioEmbedding.hpp"
 
 #include "AllocationCounter.hpp"

@@ -2,9 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include "projection_collision_avoidance/scenario/ScenarioLoader.hpp"
 #include "projection_collision_avoidance/sim/SampledSimulator.hpp"
 #include "projection_collision_avoidance/sim/ScenarioEmbedding.hpp"
-#include "projection_collision_avoidance/scenario/ScenarioLoader.hpp"
 
 #include "EigenTestHelpers.hpp"
 #include "TestScenarios.hpp"
@@ -41,7 +41,8 @@ TEST(PaperRuns, Run1LeavesTheBoundWhileTheEstimateStaysInside) {
     ASSERT_LE(sample.controller.estimate.norm(), s.xi_max) << "t=" << sample.time;
     // Before the disturbance and once xi has settled back, the estimate is xi.
     if (sample.time < 20.0 || sample.time > 40.0) {
-      ASSERT_LT((sample.controller.estimate - sample.relative_error).norm(), 1e-3) << "t=" << sample.time;
+      ASSERT_LT((sample.controller.estimate - sample.relative_error).norm(), 1e-3)
+          << "t=" << sample.time;
     }
   }
   // The RK4 safeguard on the sphere removes next to nothing: the projection does the work.
@@ -61,7 +62,8 @@ TEST(PaperRuns, Run2StaysInsideTheBound) {
   // While u_d acts the estimator, blind to it, is biased; afterwards xi returns to xi_hat.
   for (const SimulationSample& sample : trace.samples) {
     if (sample.time > 45.0) {
-      ASSERT_LT((sample.controller.estimate - sample.relative_error).norm(), 1e-3) << "t=" << sample.time;
+      ASSERT_LT((sample.controller.estimate - sample.relative_error).norm(), 1e-3)
+          << "t=" << sample.time;
     }
   }
 }
@@ -99,8 +101,10 @@ TEST(PaperRuns, RotatedIntoTwoAndThreeDimensionsGivesTheSameNorms) {
         const SimulationSample& a = reference.samples[k];
         const SimulationSample& b = rotated.samples[k];
         ASSERT_NEAR(a.relative_error.norm(), b.relative_error.norm(), 1e-9) << "t=" << a.time;
-        ASSERT_NEAR(a.controller.estimate.norm(), b.controller.estimate.norm(), 1e-9) << "t=" << a.time;
-        ASSERT_NEAR(a.controller.command.norm(), b.controller.command.norm(), 1e-9) << "t=" << a.time;
+        ASSERT_NEAR(a.controller.estimate.norm(), b.controller.estimate.norm(), 1e-9)
+            << "t=" << a.time;
+        ASSERT_NEAR(a.controller.command.norm(), b.controller.command.norm(), 1e-9)
+            << "t=" << a.time;
       }
     }
   }
@@ -123,11 +127,13 @@ TEST(PaperRuns, AccelerationLimitBoundsTheCommand) {
   for (const SimulationSample& sample : limited.samples) {
     ASSERT_LE(sample.controller.command.norm(), limit * (1.0 + 1e-12)) << "t=" << sample.time;
     ASSERT_LE(sample.controller.estimate.norm(), limited.summary.xi_max);
-    const Eigen::VectorXd sum = sample.controller.baseline_command + sample.controller.tracker_command;
+    const Eigen::VectorXd sum =
+        sample.controller.baseline_command + sample.controller.tracker_command;
     if (sum.norm() > limit) {
       ++saturated;
       EXPECT_NEAR(sample.controller.command.norm(), limit, 1e-9);
-      EXPECT_NEAR(sample.controller.command.normalized().dot(sum.normalized()), 1.0, 1e-12);  // direction
+      EXPECT_NEAR(sample.controller.command.normalized().dot(sum.normalized()), 1.0,
+                  1e-12);  // direction
     } else {
       ASSERT_NEAR((sample.controller.command - sum).norm(), 0.0, 1e-12);
     }

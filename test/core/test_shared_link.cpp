@@ -12,10 +12,10 @@
 #include <Eigen/Core>
 #include <gtest/gtest.h>
 
-#include "projection_collision_avoidance/scenario/CfSimApp.hpp"
-#include "projection_collision_avoidance/sim/SampledSimulator.hpp"
 #include "projection_collision_avoidance/core/ParameterError.hpp"
+#include "projection_collision_avoidance/scenario/CfSimApp.hpp"
 #include "projection_collision_avoidance/scenario/ScenarioLoader.hpp"
+#include "projection_collision_avoidance/sim/SampledSimulator.hpp"
 #include "projection_collision_avoidance/sim/SharedLink.hpp"
 
 #include "TestScenarios.hpp"
@@ -274,19 +274,19 @@ struct Trace {
 
 Trace trace(const std::string& file, const std::vector<std::string>& overrides) {
   Trace result;
-  result.summary = simulateFormation(
-      loadScenarioFile(scenarioPath(file), overrides),
-      [&result](int member, const SimulationSample& s) {
-        result.values.push_back(member);
-        const auto append = [&result](const auto& v) {
-          result.values.insert(result.values.end(), v.data(), v.data() + v.size());
-        };
-        append(s.relative_error);
-        append(s.controller.estimate);
-        append(s.controller.command);
-        append(s.controller.tracker_command);
-        append(s.follower_state);
-      });
+  result.summary = simulateFormation(loadScenarioFile(scenarioPath(file), overrides),
+                                     [&result](int member, const SimulationSample& s) {
+                                       result.values.push_back(member);
+                                       const auto append = [&result](const auto& v) {
+                                         result.values.insert(result.values.end(), v.data(),
+                                                              v.data() + v.size());
+                                       };
+                                       append(s.relative_error);
+                                       append(s.controller.estimate);
+                                       append(s.controller.command);
+                                       append(s.controller.tracker_command);
+                                       append(s.follower_state);
+                                     });
   return result;
 }
 

@@ -10,10 +10,10 @@
 #include <Eigen/Core>
 #include <gtest/gtest.h>
 
-#include "projection_collision_avoidance/sim/SampledSimulator.hpp"
 #include "projection_collision_avoidance/core/ControllerDesign.hpp"
 #include "projection_collision_avoidance/core/PlatoonLaws.hpp"
 #include "projection_collision_avoidance/scenario/ScenarioLoader.hpp"
+#include "projection_collision_avoidance/sim/SampledSimulator.hpp"
 #include "projection_collision_avoidance/sim/StringStability.hpp"
 
 #include "TestScenarios.hpp"

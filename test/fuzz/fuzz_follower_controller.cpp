@@ -33,9 +33,9 @@
 
 #include "projection_collision_avoidance/core/BallConstraint.hpp"
 #include "projection_collision_avoidance/core/ControllerDesign.hpp"
+#include "projection_collision_avoidance/core/DynamicFollowerController.hpp"
 #include "projection_collision_avoidance/core/FollowerController.hpp"
 #include "projection_collision_avoidance/core/ParameterError.hpp"
-#include "projection_collision_avoidance/core/DynamicFollowerController.hpp"
 
 namespace pca = projection_collision_avoidance;
 

@@ -29,10 +29,10 @@
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
 
-#include "projection_collision_avoidance/sim/SampledSimulator.hpp"
 #include "projection_collision_avoidance/core/ControllerDesign.hpp"
 #include "projection_collision_avoidance/core/Formation.hpp"
 #include "projection_collision_avoidance/ros/RosParameters.hpp"
+#include "projection_collision_avoidance/sim/SampledSimulator.hpp"
 
 #include "test_common.h"
 

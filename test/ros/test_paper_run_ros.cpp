@@ -10,9 +10,9 @@
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 
-#include "projection_collision_avoidance/sim/SampledSimulator.hpp"
 #include "projection_collision_avoidance/core/ControllerDesign.hpp"
 #include "projection_collision_avoidance/ros/RosParameters.hpp"
+#include "projection_collision_avoidance/sim/SampledSimulator.hpp"
 
 #include "test_common.h"
 

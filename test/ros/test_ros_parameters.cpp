@@ -12,8 +12,8 @@
 #include <xmlrpcpp/XmlRpcValue.h>
 
 #include "projection_collision_avoidance/core/ParameterError.hpp"
-#include "projection_collision_avoidance/scenario/ScenarioLoader.hpp"
 #include "projection_collision_avoidance/ros/RosParameters.hpp"
+#include "projection_collision_avoidance/scenario/ScenarioLoader.hpp"
 
 namespace projection_collision_avoidance {
 namespace {

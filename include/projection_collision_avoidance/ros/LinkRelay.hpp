@@ -9,8 +9,8 @@
 #include <ros/ros.h>
 
 #include "projection_collision_avoidance/LeaderBroadcast.h"
-#include "projection_collision_avoidance/sim/SharedLink.hpp"
 #include "projection_collision_avoidance/ros/InputAdmission.hpp"
+#include "projection_collision_avoidance/sim/SharedLink.hpp"
 
 namespace projection_collision_avoidance {
 

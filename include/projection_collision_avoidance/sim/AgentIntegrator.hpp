@@ -3,8 +3,8 @@
 #include <Eigen/Core>
 
 #include "projection_collision_avoidance/core/AgentModel.hpp"
-#include "projection_collision_avoidance/sim/SignalProfile.hpp"
 #include "projection_collision_avoidance/core/TypeDefs.hpp"
+#include "projection_collision_avoidance/sim/SignalProfile.hpp"
 
 namespace projection_collision_avoidance {
 

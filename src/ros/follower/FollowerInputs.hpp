@@ -9,9 +9,9 @@
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
 
-#include "projection_collision_avoidance/core/ControllerDesign.hpp"
 #include "projection_collision_avoidance/LeaderBroadcast.h"
 #include "projection_collision_avoidance/RelativeMeasurement.h"
+#include "projection_collision_avoidance/core/ControllerDesign.hpp"
 #include "projection_collision_avoidance/node/FollowerCycle.hpp"
 #include "projection_collision_avoidance/ros/InputAdmission.hpp"
 #include "projection_collision_avoidance/ros/InputGuard.hpp"

@@ -5,8 +5,8 @@
 
 #include "projection_collision_avoidance/core/ControllerParameters.hpp"
 #include "projection_collision_avoidance/core/Formation.hpp"
-#include "projection_collision_avoidance/sim/Scenario.hpp"
 #include "projection_collision_avoidance/ros/RosParameters.hpp"
+#include "projection_collision_avoidance/sim/Scenario.hpp"
 
 namespace projection_collision_avoidance {
 

@@ -2,9 +2,9 @@
 
 #include <string>
 
-#include "projection_collision_avoidance/sim/Scenario.hpp"
 #include "projection_collision_avoidance/ros/RosParameters.hpp"
 #include "projection_collision_avoidance/sim/MeasurementChannel.hpp"
+#include "projection_collision_avoidance/sim/Scenario.hpp"
 
 namespace projection_collision_avoidance {
 

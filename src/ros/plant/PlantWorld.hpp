@@ -10,13 +10,13 @@
 #include <ros/ros.h>
 #include <tf2_ros/transform_broadcaster.h>
 
-#include "projection_collision_avoidance/sim/AgentIntegrator.hpp"
 #include "projection_collision_avoidance/RelativeMeasurement.h"
-#include "projection_collision_avoidance/sim/Scenario.hpp"
 #include "projection_collision_avoidance/ros/InputAdmission.hpp"
 #include "projection_collision_avoidance/ros/InputGuard.hpp"
 #include "projection_collision_avoidance/ros/RosParameters.hpp"
+#include "projection_collision_avoidance/sim/AgentIntegrator.hpp"
 #include "projection_collision_avoidance/sim/MeasurementChannel.hpp"
+#include "projection_collision_avoidance/sim/Scenario.hpp"
 
 #include "plant/PlantClock.hpp"
 #include "plant/PlantOptions.hpp"
