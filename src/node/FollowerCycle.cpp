@@ -77,7 +77,7 @@ void FollowerCycle::adoptOffered() {
   controller_.reset(next);
 }
 
-void FollowerCycle::readInputs(std::int64_t now_ns) {
+void FollowerCycle::latchInputs() {
   if (measurement_.read()) {
     ever_measured_ = true;
   }
@@ -87,20 +87,17 @@ void FollowerCycle::readInputs(std::int64_t now_ns) {
   if (own_state_.read()) {
     ever_own_state_ = true;
   }
+}
+
+void FollowerCycle::checkTimeline(std::int64_t now_ns) {
   // An input of the old timeline (received after now: ROS time went back) is not valid.
   have_measurement_ = ever_measured_ && measurement_.value().receipt_ns <= now_ns;
   have_leader_ = ever_led_ && leader_.value().receipt_ns <= now_ns;
   have_own_state_ = ever_own_state_ && own_state_.value().receipt_ns <= now_ns;
 }
 
-bool FollowerCycle::tick(std::int64_t now_ns, std::int64_t steady_ns, double delay,
-                         std::uint32_t skipped, FollowerCycleOutput* out) {
-  // Measurement trigger: a measurement's step may run right now, in its callback; the tick
-  // waits for it (the timer trigger never takes the lock).
-  std::unique_lock<std::mutex> lock(trigger_mutex_, std::defer_lock);
-  if (settings_.measurement_trigger) {
-    lock.lock();
-  }
+bool FollowerCycle::tickLatched(std::int64_t now_ns, std::int64_t steady_ns, double delay,
+                                std::uint32_t skipped, FollowerCycleOutput* out) {
   out->stepped = false;
   time_jump_ = 0.0;
   stall_ = 0.0;
@@ -110,8 +107,7 @@ bool FollowerCycle::tick(std::int64_t now_ns, std::int64_t steady_ns, double del
   }
   latest_time_ns_ = now_ns;
   have_latest_time_ = true;
-  adoptOffered();
-  readInputs(now_ns);
+  checkTimeline(now_ns);
 
   const double grace = 0.5 * settings_.measurement_timeout;
   if (delay > grace) {
@@ -147,11 +143,9 @@ bool FollowerCycle::tick(std::int64_t now_ns, std::int64_t steady_ns, double del
   return false;
 }
 
-bool FollowerCycle::stepOnMeasurement(std::int64_t now_ns, std::uint32_t skipped,
-                                      FollowerCycleOutput* out) {
-  const std::lock_guard<std::mutex> lock(trigger_mutex_);
-  adoptOffered();
-  readInputs(now_ns);
+bool FollowerCycle::stepOnLatchedMeasurement(std::int64_t now_ns, std::uint32_t skipped,
+                                             FollowerCycleOutput* out) {
+  checkTimeline(now_ns);
   if (!have_measurement_) {
     out->stepped = false;
     fillCounters(now_ns, out);

@@ -216,6 +216,44 @@ TEST(FollowerCycle, AJumpBackOfTimeInvalidatesTheOldTimelinesInputs) {
   EXPECT_GE(out.measurement_age, 0.0);
 }
 
+TEST(FollowerCycle, AMeasurementArrivingAsATickBeginsIsNotTakenForAnOldTimeline) {
+  // The input thread writes a measurement received 1 us after the control thread read ROS time.
+  // Latched with that earlier time, it would look received in the future (of an old timeline)
+  // and the tick would brake; the tick reads the time after latching, so it steps on the one
+  // before and takes the new one at the next tick. Both triggers.
+  for (const bool measurement_trigger : {false, true}) {
+    FollowerCycleSettings settings;
+    settings.measurement_trigger = measurement_trigger;
+    std::unique_ptr<FollowerCycle> cycle = makeCycle(settings);
+    FollowerCycleOutput out;
+    cycle->measurement().write(measurementAt(kStart, 1, 5.0));
+    if (measurement_trigger) {
+      ASSERT_TRUE(cycle->stepOnMeasurement(kStart, 0, &out));
+    } else {
+      ASSERT_TRUE(cycle->tick(kStart + kMs, 0.0, 0, &out));
+    }
+    EXPECT_EQ(out.mode, FollowerMode::kTracking);
+    const std::int64_t now = kStart + 2 * kMs;
+    const auto clock_read_as_a_measurement_arrives = [&cycle, now] {
+      cycle->measurement().write(measurementAt(now + 1000, 2, 5.0));
+      return now;
+    };
+    EXPECT_EQ(cycle->tick(clock_read_as_a_measurement_arrives, now, 0.0, 0, &out),
+              !measurement_trigger)
+        << "measurement trigger: " << measurement_trigger;
+    EXPECT_EQ(out.mode, FollowerMode::kTracking) << "measurement trigger: " << measurement_trigger;
+    EXPECT_FALSE(out.status.fallback);
+    if (measurement_trigger) {
+      ASSERT_TRUE(cycle->stepOnMeasurement(now + 2000, 0, &out));
+      EXPECT_EQ(out.stamp_ns, now + 1000);  // the step answering it
+    } else {
+      ASSERT_TRUE(cycle->tick(now + kMs, 0.0, 0, &out));
+      EXPECT_NEAR(out.measurement_age, 0.001 - 1e-6, 1e-12);  // the new one
+    }
+    EXPECT_EQ(out.mode, FollowerMode::kTracking);
+  }
+}
+
 TEST(FollowerCycle, AfterAStallItWaitsForTheInputSentMeanwhile) {
   std::unique_ptr<FollowerCycle> cycle = makeCycle();
   FollowerCycleOutput out;

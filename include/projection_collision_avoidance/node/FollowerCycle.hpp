@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <memory>
 #include <mutex>
+#include <type_traits>
 
 #include "projection_collision_avoidance/core/DynamicFollowerController.hpp"
 #include "projection_collision_avoidance/core/FollowerMode.hpp"
@@ -91,13 +92,13 @@ struct FollowerCycleOutput {
 /// trigger, whose steps run in the measurement's callback, and a tick waits for a step running
 /// there) or makes a system call, so that a real-time thread can run it.
 ///
-/// Time: every call gives the ROS time `now_ns`. An input is valid while it was received at or
-/// before now (after a jump back of ROS time, those of the old timeline are not, so the follower
-/// brakes until new ones arrive); its age counts from min(stamp, receipt). A tick more than half
-/// the measurement timeout late (a stalled process) starts a wait: ticks are skipped and counted
-/// as missed until a measurement arrives or half the timeout has passed on the steady clock
-/// (simulated time can catch up by seconds within a millisecond when a stalled process resumes,
-/// before the measurements sent meanwhile are read).
+/// Time: every call reads the ROS time `now_ns` after it has latched the inputs. An input is valid
+/// while it was received at or before now (after a jump back of ROS time, those of the old timeline
+/// are not, so the follower brakes until new ones arrive); its age counts from min(stamp, receipt).
+/// A tick more than half the measurement timeout late (a stalled process) starts a wait: ticks are
+/// skipped and counted as missed until a measurement arrives or half the timeout has passed on the
+/// steady clock (simulated time can catch up by seconds within a millisecond when a stalled process
+/// resumes, before the measurements sent meanwhile are read).
 class FollowerCycle {
  public:
   /// @param controller the controller, moved in
@@ -115,21 +116,50 @@ class FollowerCycle {
   /// The slot the own odometry's callback writes (one writer thread; time headway only).
   LatestValue<OwnStateSample>& ownState() { return own_state_; }
 
-  /// A tick of the fixed-rate loop at ROS time @p now_ns and steady (monotonic) time
-  /// @p steady_ns, @p delay s after it was due, with @p skipped periods skipped before it. Timer
-  /// trigger: a step stamped now. Measurement trigger: a braking step once the measurement is
-  /// stale, else nothing.
+  /// A tick of the fixed-rate loop at steady (monotonic) time @p steady_ns, @p delay s after it
+  /// was due, with @p skipped periods skipped before it. It latches the inputs first and then
+  /// reads ROS time with @p ros_now (a callable returning ns), so that every input it reads was
+  /// received at or before the time it steps at; an input received after it is then one of an old
+  /// timeline, never one that arrived while the tick began. Timer trigger: a step stamped now.
+  /// Measurement trigger: a braking step once the measurement is stale, else nothing.
   /// @return whether @p out got a step (out->stepped); the counters are filled either way
+  template <typename RosNow,
+            typename = std::enable_if_t<std::is_invocable_r_v<std::int64_t, RosNow&>>>
+  bool tick(RosNow&& ros_now, std::int64_t steady_ns, double delay, std::uint32_t skipped,
+            FollowerCycleOutput* out) {
+    std::unique_lock<std::mutex> lock(trigger_mutex_, std::defer_lock);
+    if (settings_.measurement_trigger) {
+      lock.lock();  // a measurement's step may be running in its callback: wait for it
+    }
+    adoptOffered();
+    latchInputs();
+    return tickLatched(ros_now(), steady_ns, delay, skipped, out);
+  }
+  /// tick() at the given ROS time @p now_ns.
   bool tick(std::int64_t now_ns, std::int64_t steady_ns, double delay, std::uint32_t skipped,
-            FollowerCycleOutput* out);
+            FollowerCycleOutput* out) {
+    return tick([now_ns] { return now_ns; }, steady_ns, delay, skipped, out);
+  }
   /// tick() where ROS time is the steady clock (wall time that does not jump).
   bool tick(std::int64_t now_ns, double delay, std::uint32_t skipped, FollowerCycleOutput* out) {
     return tick(now_ns, now_ns, delay, skipped, out);
   }
 
   /// The step answering the measurement just written to measurement() (measurement trigger),
-  /// stamped with its stamp, at ROS time @p now_ns; @p skipped periods since the one before.
-  bool stepOnMeasurement(std::int64_t now_ns, std::uint32_t skipped, FollowerCycleOutput* out);
+  /// stamped with its stamp, at the ROS time @p ros_now gives (ns) once the inputs are latched;
+  /// @p skipped periods since the one before.
+  template <typename RosNow,
+            typename = std::enable_if_t<std::is_invocable_r_v<std::int64_t, RosNow&>>>
+  bool stepOnMeasurement(RosNow&& ros_now, std::uint32_t skipped, FollowerCycleOutput* out) {
+    const std::lock_guard<std::mutex> lock(trigger_mutex_);
+    adoptOffered();
+    latchInputs();
+    return stepOnLatchedMeasurement(ros_now(), skipped, out);
+  }
+  /// stepOnMeasurement() at the given ROS time @p now_ns.
+  bool stepOnMeasurement(std::int64_t now_ns, std::uint32_t skipped, FollowerCycleOutput* out) {
+    return stepOnMeasurement([now_ns] { return now_ns; }, skipped, out);
+  }
 
   /// Hands over a controller for a new design (built elsewhere, e.g. by reconfiguration); a
   /// coming tick adopts it, carrying over the estimate and previous command, once the controller
@@ -146,7 +176,14 @@ class FollowerCycle {
  private:
   /// One control step at ROS time @p now_ns, stamped @p stamp_ns, @p delay s after it was due.
   bool step(std::int64_t now_ns, std::int64_t stamp_ns, double delay, FollowerCycleOutput* out);
-  void readInputs(std::int64_t now_ns);
+  /// Reads the latest inputs from their slots.
+  void latchInputs();
+  /// Which latched inputs are of this timeline at ROS time @p now_ns (received at or before it).
+  void checkTimeline(std::int64_t now_ns);
+  bool tickLatched(std::int64_t now_ns, std::int64_t steady_ns, double delay, std::uint32_t skipped,
+                   FollowerCycleOutput* out);
+  bool stepOnLatchedMeasurement(std::int64_t now_ns, std::uint32_t skipped,
+                                FollowerCycleOutput* out);
   void adoptOffered();
   /// The counters and the design in force into @p out (whether or not a step ran).
   void fillCounters(std::int64_t now_ns, FollowerCycleOutput* out) const;

@@ -104,7 +104,10 @@ void FollowerInputs::onMeasurement(const RelativeMeasurement::ConstPtr& msg) {
     measurement_.relative_state = relative_state_;
     cycle_->measurement().write(measurement_);
     if (options_.trigger == ControlTrigger::kMeasurement) {
-      cycle_->stepOnMeasurement(nanosecondsOf(now), skipped, &trigger_output_);
+      // ROS time read again once the other inputs are latched (their callbacks may run on other
+      // threads): none of them counts as received after the step's time.
+      cycle_->stepOnMeasurement([] { return nanosecondsOf(ros::Time::now()); }, skipped,
+                                &trigger_output_);
       on_step_(trigger_output_);
     }
   });

@@ -13,6 +13,9 @@
 namespace projection_collision_avoidance {
 namespace {
 
+/// ROS time now (ns); a tick reads it once it has latched its inputs.
+std::int64_t rosNanoseconds() { return nanosecondsOf(ros::Time::now()); }
+
 /// CLOCK_MONOTONIC (ns), the clock of the real-time thread's ticks.
 std::int64_t steadyNanoseconds() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(
@@ -74,7 +77,7 @@ void FollowerLoop::onTimer(const ros::TimerEvent& event) {
       last_expected_ = event.current_expected;
       have_last_expected_ = true;
     }
-    cycle_->tick(nanosecondsOf(now), steadyNanoseconds(), delay, skipped, &timer_output_);
+    cycle_->tick(rosNanoseconds, steadyNanoseconds(), delay, skipped, &timer_output_);
     outputs_->publish(timer_output_);
   } catch (const std::exception& error) {
     ROS_ERROR_STREAM_THROTTLE(5.0, name_ << ": control tick failed: " << error.what());
@@ -88,7 +91,7 @@ void FollowerLoop::onThreadTick(const PeriodicTick& tick) {
   try {
     const double delay = 1e-9 * static_cast<double>(tick.actual - tick.expected);
     const std::uint64_t most = std::numeric_limits<std::uint32_t>::max();
-    cycle_->tick(nanosecondsOf(ros::Time::now()), tick.actual, delay,
+    cycle_->tick(rosNanoseconds, tick.actual, delay,
                  static_cast<std::uint32_t>(std::min(tick.skipped, most)), &thread_output_);
     outputs_->post(thread_output_);
   } catch (const std::exception& error) {
