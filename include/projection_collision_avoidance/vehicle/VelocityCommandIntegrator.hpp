@@ -1,0 +1,95 @@
+#pragma once
+
+/// @file
+/// The follower's acceleration command a (m/s²) turned into a velocity command (m/s) for
+/// velocity-controlled vehicles (Twist, TwistStamped, MAVROS velocity setpoints), without
+/// integrator wind-up (doc/vehicles.md).
+
+#include <limits>
+
+#include <Eigen/Core>
+
+#include "projection_collision_avoidance/core/TypeDefs.hpp"
+
+namespace projection_collision_avoidance {
+
+/// A vector of 1 to 3 axes (m/s or m/s²), stored inline.
+using AxisVector = BoundedMatrix<Eigen::Dynamic, 1, 3, 1>;
+
+/// What the velocity command was built on.
+enum class VelocityAnchor {
+  kMeasured,         ///< the vehicle's fresh measured velocity
+  kPreviousCommand,  ///< the previous command (no fresh measurement)
+};
+
+/// Options of VelocityCommandIntegrator.
+struct VelocityIntegratorOptions {
+  int axes = 2;  ///< 1, 2 or 3
+  /// ‖v_cmd‖ ≤ max_speed (m/s), > 0; infinity: none
+  double max_speed = std::numeric_limits<double>::infinity();
+  /// A measured velocity is fresh while |now − its stamp| ≤ max_measurement_age (s), ≥ 0
+  double max_measurement_age = 0.1;
+  /// τ (s), ≥ 0: the time constant of the vehicle's velocity loop, v̇ = (v_cmd − v) / τ; 0 for
+  /// a vehicle that reaches its command within a period
+  double velocity_lag = 0.0;
+};
+
+/// One velocity command and how it was made.
+struct VelocityCommand {
+  AxisVector velocity;  ///< v_cmd (m/s), in the frame of the acceleration (the world frame)
+  VelocityAnchor anchor = VelocityAnchor::kPreviousCommand;
+  bool limited = false;  ///< ‖anchor + a h‖ exceeded max_speed: scaled onto it (same direction)
+  /// a or T not finite, T ≤ 0, a of the wrong size, or anchor + a h overflowing:
+  /// v_cmd = clamp(anchor)
+  bool refused = false;
+};
+
+/// The lead h (s) by which the command leads the measured velocity, so that a vehicle with a
+/// first-order velocity lag τ sampled every T gains a T per period: h = T / (1 − e^(−T/τ)),
+/// h = T for τ = 0 (h ≥ T; h ≈ τ + T/2 for τ ≫ T).
+double velocityLead(double period, double velocity_lag);
+
+/// v_cmd(k+1) = clamp(v_anchor + a h, max_speed):
+/// - anchor = the measured velocity when fresh, h = velocityLead(T, τ): the command is a fixed
+///   lead a h ahead of what the vehicle does, so when the vehicle's own controller saturates
+///   (it cannot follow) the command stays at v_measured + a h instead of growing: no wind-up, by
+///   construction (there is no integrator state).
+/// - anchor = the previous command when the measurement is not fresh, h = T: a plain integrator,
+///   whose state is the limited command itself (clamping anti-windup at max_speed).
+/// clamp() scales a vector longer than max_speed onto it, keeping its direction (clampNorm()).
+/// Before the first command the previous one is zero (a vehicle at rest). Never throws on inputs
+/// and allocates nothing.
+class VelocityCommandIntegrator {
+ public:
+  /// @throws ParameterError naming vehicle.velocity.axes, .max_speed, .max_measurement_age or
+  ///         .velocity_lag
+  explicit VelocityCommandIntegrator(const VelocityIntegratorOptions& options);
+
+  /// Notes the vehicle's measured velocity (m/s, the command's frame) at @p stamp (s).
+  /// @return false (and nothing noted) if not finite or not of the options' axes
+  bool measure(const AxisVector& velocity, double stamp);
+
+  /// The command for the follower's acceleration @p acceleration (m/s²) over the period
+  /// @p period (s) at time @p now (s); it becomes the previous command.
+  const VelocityCommand& step(const AxisVector& acceleration, double period, double now);
+
+  /// Replaces the previous command by what was actually sent after limits further down (the
+  /// unicycle's: s ṗ_l), so that an integration without measurements starts from it. Ignored if
+  /// not finite or of the wrong size.
+  void setSent(const AxisVector& velocity);
+
+  /// Back to rest: previous command zero, no measurement.
+  void reset();
+
+  const VelocityCommand& last() const { return command_; }
+  const VelocityIntegratorOptions& options() const { return options_; }
+
+ private:
+  VelocityIntegratorOptions options_;
+  AxisVector measured_;
+  double measured_stamp_ = 0.0;
+  bool have_measurement_ = false;
+  VelocityCommand command_;
+};
+
+}  // namespace projection_collision_avoidance
