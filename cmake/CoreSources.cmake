@@ -40,3 +40,13 @@ set(PCA_SCENARIO_SOURCES
   src/scenario/ScenarioLoader.cpp
   src/scenario/YamlParser.cpp
 )
+
+# projection_collision_avoidance_vehicle: the vehicle adapters' math (odometry pairs to a relative
+# state, the unicycle's look-ahead point, velocity commands, the output timeout); Eigen and std.
+set(PCA_VEHICLE_SOURCES
+  src/vehicle/OutputWatchdog.cpp
+  src/vehicle/RelativeStateFromOdometry.cpp
+  src/vehicle/Rotation.cpp
+  src/vehicle/UnicycleLookAhead.cpp
+  src/vehicle/VelocityCommandIntegrator.cpp
+)
