@@ -3,6 +3,7 @@
 /// common factor, the direction of ṗ_l kept, flags), refused inputs, and what a perimeter kept by
 /// the look-ahead points guarantees for the axles.
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -173,6 +174,25 @@ TEST(UnicycleLookAhead, LimitedCommandsStayWithinTheLimitsAlongTheWantedDirectio
     limited += c.scale < 1.0 ? 1 : 0;
   }
   EXPECT_GT(limited, 1000);  // the limits acted in most trials
+}
+
+TEST(UnicycleLookAhead, NoLimitActsWhileTheLookAheadSpeedIsWithinBoth) {
+  // |v| ≤ ‖ṗ_l‖ and |ω| ≤ ‖ṗ_l‖ / l, so ‖ṗ_l‖ ≤ min(max_speed, l max_yaw_rate) is never limited.
+  std::mt19937 rng(71);
+  std::uniform_real_distribution<double> angle(-4.0, 4.0);
+  std::uniform_real_distribution<double> fraction(0.0, 1.0);
+  const UnicycleLookAhead map(0.2, {0.6, 1.5});
+  const double reachable = std::min(0.6, 0.2 * 1.5);
+  for (int trial = 0; trial < 2000; ++trial) {
+    const double direction = angle(rng);
+    const Eigen::Vector2d wanted =
+        reachable * fraction(rng) * Eigen::Vector2d(std::cos(direction), std::sin(direction));
+    const UnicycleCommand c = map.command(angle(rng), wanted);
+    EXPECT_EQ(c.scale, 1.0);
+    EXPECT_FALSE(c.speed_limited || c.yaw_rate_limited);
+  }
+  // Just past it, along the heading's normal, the yaw rate is limited.
+  EXPECT_TRUE(map.command(0.0, Eigen::Vector2d(0.0, 0.3 * (1.0 + 1e-12))).yaw_rate_limited);
 }
 
 TEST(UnicycleLookAhead, RefusesNonFiniteInputsWithAZeroCommand) {
