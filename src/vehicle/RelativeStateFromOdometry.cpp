@@ -21,8 +21,8 @@ bool sampleFinite(const OdometrySample& sample, const Eigen::Vector3d& point) {
 
 void requireNonNegative(double value, const std::string& key, const char* unit) {
   if (!(value >= 0.0) || !std::isfinite(value)) {
-    throw ParameterError(key, std::string("must be finite and >= 0 ") + unit + ", got " +
-                                  std::to_string(value));
+    throw ParameterError(
+        key, std::string("must be finite and >= 0 ") + unit + ", got " + std::to_string(value));
   }
 }
 
@@ -118,7 +118,8 @@ RelativeOdometryResult RelativeStateFromOdometry::compute(const OdometrySample& 
     result.verdict = OdometryVerdict::kSkewTooLarge;
     return result;
   }
-  Eigen::Matrix<double, 6, 1> x_self = bodyPointState(own, options_.self_point, options_.twist_frame);
+  Eigen::Matrix<double, 6, 1> x_self =
+      bodyPointState(own, options_.self_point, options_.twist_frame);
   Eigen::Matrix<double, 6, 1> x_target =
       bodyPointState(other, options_.target_point, options_.twist_frame);
   // Constant velocity over the skew: the older sample's point moves to the newer stamp.

@@ -23,14 +23,13 @@ VelocityCommandIntegrator::VelocityCommandIntegrator(const VelocityIntegratorOpt
                          "must be 1, 2 or 3, got " + std::to_string(options.axes));
   }
   if (!(options.max_speed > 0.0)) {
-    throw ParameterError("vehicle.velocity.max_speed",
-                         "must be > 0 m/s (or infinity: none), got " +
-                             std::to_string(options.max_speed));
+    throw ParameterError("vehicle.velocity.max_speed", "must be > 0 m/s (or infinity: none), got " +
+                                                           std::to_string(options.max_speed));
   }
   if (!(options.max_measurement_age >= 0.0) || !std::isfinite(options.max_measurement_age)) {
-    throw ParameterError("vehicle.velocity.max_measurement_age",
-                         "must be finite and >= 0 s, got " +
-                             std::to_string(options.max_measurement_age));
+    throw ParameterError(
+        "vehicle.velocity.max_measurement_age",
+        "must be finite and >= 0 s, got " + std::to_string(options.max_measurement_age));
   }
   if (!(options.velocity_lag >= 0.0) || !std::isfinite(options.velocity_lag)) {
     throw ParameterError("vehicle.velocity.velocity_lag",

@@ -55,10 +55,10 @@ std::string refusedKey(const OdometryAlignmentOptions& o) {
 
 TEST(Rotation, BodyToWorldHandComputed) {
   // Yaw 90°: the body's x axis points along the world's y axis.
-  EXPECT_MATRIX_NEAR(bodyToWorld(yaw(kPi / 2), Eigen::Vector3d(1, 0, 0)),
-                     Eigen::Vector3d(0, 1, 0), 1e-15);
-  EXPECT_MATRIX_NEAR(bodyToWorld(yaw(kPi / 2), Eigen::Vector3d(0, 1, 0)),
-                     Eigen::Vector3d(-1, 0, 0), 1e-15);
+  EXPECT_MATRIX_NEAR(bodyToWorld(yaw(kPi / 2), Eigen::Vector3d(1, 0, 0)), Eigen::Vector3d(0, 1, 0),
+                     1e-15);
+  EXPECT_MATRIX_NEAR(bodyToWorld(yaw(kPi / 2), Eigen::Vector3d(0, 1, 0)), Eigen::Vector3d(-1, 0, 0),
+                     1e-15);
   // q = Rz(90°) Rx(90°): body x → world y, body y → world z, body z → world x.
   const Eigen::Quaterniond q = yaw(kPi / 2) * Eigen::AngleAxisd(kPi / 2, Eigen::Vector3d::UnitX());
   EXPECT_MATRIX_NEAR(bodyToWorld(q, Eigen::Vector3d(1, 2, 3)), Eigen::Vector3d(3, 1, 2), 1e-15);
@@ -75,7 +75,7 @@ TEST(Rotation, NormalisesWithinTheToleranceAndRefusesBeyond) {
   Eigen::Quaterniond far(yaw(0.3).coeffs() * 1.02);
   const Eigen::Vector4d before = far.coeffs();
   EXPECT_EQ(normaliseQuaternion(far, 1e-2), QuaternionStatus::kNotUnit);
-  EXPECT_EQ(far.coeffs(), before);  // left unchanged
+  EXPECT_EQ(far.coeffs(), before);      // left unchanged
   Eigen::Quaterniond zero(0, 0, 0, 0);  // an orientation that was never filled in
   EXPECT_EQ(normaliseQuaternion(zero, 1e-2), QuaternionStatus::kNotUnit);
   EXPECT_EQ(normaliseQuaternion(zero, kInf), QuaternionStatus::kNotUnit);
@@ -104,10 +104,10 @@ TEST(RelativeStateFromOdometry, PlanarBodyTwistsRotatedByTheirYaw) {
   const RelativeStateFromOdometry adapter(options(2));
   // The follower at (1, 2) heading +y at 1 m/s forward; the target at (4, 6) heading +x at
   // 2 m/s forward and 0.5 m/s to its left (world +y).
-  const OdometrySample self = sample(5.0, Eigen::Vector3d(1, 2, 0.3), yaw(kPi / 2),
-                                     Eigen::Vector3d(1, 0, 0));
-  const OdometrySample target = sample(5.0, Eigen::Vector3d(4, 6, -0.2), yaw(0.0),
-                                       Eigen::Vector3d(2, 0.5, 0));
+  const OdometrySample self =
+      sample(5.0, Eigen::Vector3d(1, 2, 0.3), yaw(kPi / 2), Eigen::Vector3d(1, 0, 0));
+  const OdometrySample target =
+      sample(5.0, Eigen::Vector3d(4, 6, -0.2), yaw(0.0), Eigen::Vector3d(2, 0.5, 0));
   const RelativeOdometryResult r = adapter.compute(self, target);
   ASSERT_TRUE(r.accepted()) << toString(r.verdict);
   ASSERT_EQ(r.state.size(), 4);
@@ -143,8 +143,8 @@ TEST(RelativeStateFromOdometry, SpatialBodyTwistsRotatedByTheirOrientation) {
 
 TEST(RelativeStateFromOdometry, OlderSampleExtrapolatedAtConstantVelocity) {
   const RelativeStateFromOdometry adapter(options(2, 0.1));
-  const OdometrySample self = sample(10.0, Eigen::Vector3d(0, 0, 0), yaw(0.0),
-                                     Eigen::Vector3d(2, 0, 0));
+  const OdometrySample self =
+      sample(10.0, Eigen::Vector3d(0, 0, 0), yaw(0.0), Eigen::Vector3d(2, 0, 0));
   const OdometrySample target = sample(10.0625, Eigen::Vector3d(3, 1, 0), yaw(kPi / 2),
                                        Eigen::Vector3d(1, 0, 0));  // world (0, 1)
   RelativeOdometryResult r = adapter.compute(self, target);
@@ -157,8 +157,8 @@ TEST(RelativeStateFromOdometry, OlderSampleExtrapolatedAtConstantVelocity) {
   EXPECT_MATRIX_NEAR(r.state, Eigen::Vector4d(2.875, 1, -2, 1), 1e-14);
 
   // The other way round: the target's sample is the older one.
-  const OdometrySample late_self = sample(10.125, Eigen::Vector3d(0, 0, 0), yaw(0.0),
-                                          Eigen::Vector3d(2, 0, 0));
+  const OdometrySample late_self =
+      sample(10.125, Eigen::Vector3d(0, 0, 0), yaw(0.0), Eigen::Vector3d(2, 0, 0));
   r = adapter.compute(late_self, target);
   ASSERT_TRUE(r.accepted());
   EXPECT_TRUE(r.target_extrapolated);
@@ -168,14 +168,15 @@ TEST(RelativeStateFromOdometry, OlderSampleExtrapolatedAtConstantVelocity) {
 
 TEST(RelativeStateFromOdometry, SkewAcceptedAtItsLimitAndRefusedOnePast) {
   const RelativeStateFromOdometry adapter(options(2, 0.25));
-  const OdometrySample self = sample(10.0, Eigen::Vector3d::Zero(), yaw(0.0),
-                                     Eigen::Vector3d::Zero());
-  OdometrySample target = sample(10.25, Eigen::Vector3d(1, 0, 0), yaw(0.0),
-                                 Eigen::Vector3d::Zero());
+  const OdometrySample self =
+      sample(10.0, Eigen::Vector3d::Zero(), yaw(0.0), Eigen::Vector3d::Zero());
+  OdometrySample target =
+      sample(10.25, Eigen::Vector3d(1, 0, 0), yaw(0.0), Eigen::Vector3d::Zero());
   EXPECT_TRUE(adapter.compute(self, target).accepted());
   EXPECT_TRUE(adapter.compute(target, self).accepted());
   target.stamp = std::nextafter(10.25, kInf);
-  for (const RelativeOdometryResult& r : {adapter.compute(self, target), adapter.compute(target, self)}) {
+  for (const RelativeOdometryResult& r :
+       {adapter.compute(self, target), adapter.compute(target, self)}) {
     EXPECT_FALSE(r.accepted());
     EXPECT_EQ(r.verdict, OdometryVerdict::kSkewTooLarge);
     EXPECT_STREQ(toString(r.verdict), "skew_too_large");
@@ -191,10 +192,10 @@ TEST(RelativeStateFromOdometry, SkewAcceptedAtItsLimitAndRefusedOnePast) {
 
 TEST(RelativeStateFromOdometry, QuaternionsNormalisedWithinTheToleranceRefusedBeyond) {
   const RelativeStateFromOdometry adapter(options(2));
-  const OdometrySample self = sample(2.0, Eigen::Vector3d(0, 0, 0), yaw(0.4),
-                                     Eigen::Vector3d(1, 0, 0));
-  const OdometrySample target = sample(2.0, Eigen::Vector3d(2, 0, 0), yaw(-0.8),
-                                       Eigen::Vector3d(1.5, 0, 0));
+  const OdometrySample self =
+      sample(2.0, Eigen::Vector3d(0, 0, 0), yaw(0.4), Eigen::Vector3d(1, 0, 0));
+  const OdometrySample target =
+      sample(2.0, Eigen::Vector3d(2, 0, 0), yaw(-0.8), Eigen::Vector3d(1.5, 0, 0));
   const RelativeOdometryResult unit = adapter.compute(self, target);
   ASSERT_TRUE(unit.accepted());
 
@@ -213,8 +214,8 @@ TEST(RelativeStateFromOdometry, QuaternionsNormalisedWithinTheToleranceRefusedBe
 
 TEST(RelativeStateFromOdometry, NonFiniteValuesRefusedNeverThrown) {
   const RelativeStateFromOdometry adapter(options(3));
-  const OdometrySample good = sample(1.0, Eigen::Vector3d(1, 2, 3), yaw(0.1),
-                                     Eigen::Vector3d(0.1, 0, 0));
+  const OdometrySample good =
+      sample(1.0, Eigen::Vector3d(1, 2, 3), yaw(0.1), Eigen::Vector3d(0.1, 0, 0));
   OdometrySample bad = good;
   bad.position.y() = kNaN;
   EXPECT_EQ(adapter.compute(bad, good).verdict, OdometryVerdict::kSelfNotFinite);
@@ -267,9 +268,8 @@ TEST(RelativeStateFromOdometry, LookAheadPointsAsTheUnicycleMapGivesThem) {
   target.angular_velocity.z() = target_body.omega;
   const RelativeOdometryResult r = RelativeStateFromOdometry(o).compute(self, target);
   ASSERT_TRUE(r.accepted());
-  EXPECT_MATRIX_NEAR(r.state,
-                     other.state(target_pose, target_body) - own.state(self_pose, self_body),
-                     1e-14);
+  EXPECT_MATRIX_NEAR(
+      r.state, other.state(target_pose, target_body) - own.state(self_pose, self_body), 1e-14);
 }
 
 }  // namespace

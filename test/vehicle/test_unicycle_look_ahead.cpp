@@ -101,8 +101,8 @@ TEST(UnicycleLookAhead, VelocityFromWorldMatchesFiniteDifferenceWhenSlipping) {
   // Without slip it is velocity().
   const double theta = 0.9;
   const Eigen::Vector2d forward = 0.7 * Eigen::Vector2d(std::cos(theta), std::sin(theta));
-  EXPECT_MATRIX_NEAR(map.velocityFromWorld(theta, forward, omega), map.velocity(theta, {0.7, omega}),
-                     1e-15);
+  EXPECT_MATRIX_NEAR(map.velocityFromWorld(theta, forward, omega),
+                     map.velocity(theta, {0.7, omega}), 1e-15);
 }
 
 TEST(UnicycleLookAhead, InverseRecoversTheBodyVelocities) {

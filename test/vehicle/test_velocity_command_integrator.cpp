@@ -180,8 +180,10 @@ TEST(VelocityCommandIntegrator, RefusedInputsHoldTheAnchor) {
   EXPECT_FALSE(integrator.measure(vec(1.0, 0.0), kInf));
   ASSERT_TRUE(integrator.measure(vec(1.0, 0.5), 0.0));
   for (const auto& [a, T] : {std::pair<AxisVector, double>{vec(kNaN, 0.0), 0.1},
-                             {vec(1.0, 1.0), 0.0}, {vec(1.0, 1.0), -0.1},
-                             {vec(1.0, 1.0), kInf}, {vec(1.0), 0.1},
+                             {vec(1.0, 1.0), 0.0},
+                             {vec(1.0, 1.0), -0.1},
+                             {vec(1.0, 1.0), kInf},
+                             {vec(1.0), 0.1},
                              {vec(1e308, 0.0), 1e10}}) {
     const VelocityCommand c = integrator.step(a, T, 0.0);
     EXPECT_TRUE(c.refused);

@@ -21,14 +21,14 @@ const char* toString(WatchdogState state);
 
 /// One decision of the watchdog.
 struct WatchdogDecision {
-  bool send_stop = true;   ///< publish the stack's stop now (again at every check while true)
-  bool stop_began = false; ///< the first stop since the last command was fresh (log it once)
+  bool send_stop = true;    ///< publish the stack's stop now (again at every check while true)
+  bool stop_began = false;  ///< the first stop since the last command was fresh (log it once)
   WatchdogState state = WatchdogState::kNoCommandYet;
 };
 
-/// Stop iff no command came within the last timeout: age = now − t_last, stop ⇔ ¬(0 ≤ age ≤ timeout)
-/// (times in s). A command exactly timeout old is still fresh. Time going back (a looping bag,
-/// a reset simulated clock) forgets the last command: the age is unknown, so the adapter stops
+/// Stop iff no command came within the last timeout: age = now − t_last, stop ⇔ ¬(0 ≤ age ≤
+/// timeout) (times in s). A command exactly timeout old is still fresh. Time going back (a looping
+/// bag, a reset simulated clock) forgets the last command: the age is unknown, so the adapter stops
 /// until a new command arrives. The stop is repeated at every check, since some stacks (PX4's
 /// offboard mode through MAVROS) leave their mode without a steady stream of setpoints.
 class OutputWatchdog {

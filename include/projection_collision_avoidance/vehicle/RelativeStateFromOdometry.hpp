@@ -16,9 +16,10 @@ namespace projection_collision_avoidance {
 /// One odometry sample as REP 105 defines nav_msgs/Odometry: the pose in the world frame
 /// (header.frame_id), the twist in the body frame (child_frame_id).
 struct OdometrySample {
-  double stamp = 0.0;                                     ///< header.stamp (s)
-  Eigen::Vector3d position = Eigen::Vector3d::Zero();     ///< pose.position, world frame (m)
-  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  ///< pose.orientation: body → world
+  double stamp = 0.0;                                  ///< header.stamp (s)
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();  ///< pose.position, world frame (m)
+  /// pose.orientation: rotates body-frame vectors into the world frame
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
   Eigen::Vector3d linear_velocity = Eigen::Vector3d::Zero();   ///< twist.linear (m/s)
   Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();  ///< twist.angular (rad/s)
 };
@@ -44,12 +45,12 @@ struct OdometryAlignmentOptions {
 /// Why compute() accepted or refused a pair of samples.
 enum class OdometryVerdict {
   kAccepted,
-  kSelfNotFinite,            ///< a NaN or infinite stamp, position, orientation or velocity
+  kSelfNotFinite,  ///< a NaN or infinite stamp, position, orientation or velocity
   kTargetNotFinite,
-  kSelfQuaternionNotUnit,    ///< |‖q‖ − 1| beyond quaternion_tolerance
+  kSelfQuaternionNotUnit,  ///< |‖q‖ − 1| beyond quaternion_tolerance
   kTargetQuaternionNotUnit,
-  kSkewTooLarge,             ///< |t_target − t_self| > max_skew
-  kOverflow,                 ///< finite samples whose aligned difference is not finite
+  kSkewTooLarge,  ///< |t_target − t_self| > max_skew
+  kOverflow,      ///< finite samples whose aligned difference is not finite
 };
 
 /// A short reason: "accepted", "self_not_finite", ..., "skew_too_large", "overflow".
@@ -61,8 +62,8 @@ using PlanarOrSpatialState = BoundedMatrix<Eigen::Dynamic, 1, 6, 1>;
 /// What compute() gives. Only verdict is meaningful unless accepted().
 struct RelativeOdometryResult {
   OdometryVerdict verdict = OdometryVerdict::kAccepted;
-  double stamp = 0.0;  ///< the common time, the newer of the two stamps (s)
-  double skew = 0.0;   ///< |t_target − t_self| (s); NaN if a stamp is not finite
+  double stamp = 0.0;                ///< the common time, the newer of the two stamps (s)
+  double skew = 0.0;                 ///< |t_target − t_self| (s); NaN if a stamp is not finite
   bool target_extrapolated = false;  ///< the target's sample was the older one
   bool self_extrapolated = false;    ///< the follower's own sample was the older one
   PlanarOrSpatialState state;        ///< x_target − x_self at stamp = [Δp; Δv] (m, m/s)

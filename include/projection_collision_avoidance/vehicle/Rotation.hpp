@@ -12,9 +12,9 @@ namespace projection_collision_avoidance {
 
 /// What normaliseQuaternion() found.
 enum class QuaternionStatus {
-  kUnit,        ///< usable: |‖q‖ − 1| ≤ tolerance; q now divided by ‖q‖
-  kNotFinite,   ///< a coefficient is NaN or infinite: refused, q unchanged
-  kNotUnit,     ///< |‖q‖ − 1| > tolerance (the all-zero "unset" quaternion among them): refused
+  kUnit,       ///< usable: |‖q‖ − 1| ≤ tolerance; q now divided by ‖q‖
+  kNotFinite,  ///< a coefficient is NaN or infinite: refused, q unchanged
+  kNotUnit,    ///< |‖q‖ − 1| > tolerance (the all-zero quaternion among them): refused
 };
 
 /// Makes @p q of unit length, q ← q / ‖q‖, when |‖q‖ − 1| ≤ @p tolerance (dimensionless, ≥ 0);

@@ -52,7 +52,8 @@ class UnicycleLookAhead {
   /// The look-ahead point (m): p_l = p + l [cos θ, sin θ].
   Eigen::Vector2d point(const UnicyclePose& pose) const;
 
-  /// Its velocity (m/s) for body velocities (v, ω): ṗ_l = [v cos θ − l ω sin θ, v sin θ + l ω cos θ].
+  /// Its velocity (m/s) for body velocities (v, ω):
+  /// ṗ_l = [v cos θ − l ω sin θ, v sin θ + l ω cos θ].
   Eigen::Vector2d velocity(double theta, const UnicycleVelocity& body) const;
 
   /// Its velocity (m/s) from the axle's world velocity ṗ (m/s), which may slip sideways, and
@@ -83,8 +84,8 @@ class UnicycleLookAhead {
 
 /// What a perimeter kept by two controlled points guarantees for their agents' reference points
 /// (the axles' midpoints), each controlled point at a fixed distance l_i from its reference point:
-/// ‖p_1 − p_2‖ ≥ ‖p_l1 − p_l2‖ − l_self − l_target (triangle inequality; equality when both
-/// look-ahead points lie on the segment between the axles, the robots facing each other).
+/// ‖p_1 − p_2‖ ≥ ‖p_l1 − p_l2‖ − l_self − l_target (triangle inequality; equality when the
+/// robots stand back to back on one line, each controlled point beyond its axle).
 /// @return max(0, look_ahead_distance − l_self − l_target) (m), a lower bound on ‖p_1 − p_2‖
 double referenceDistanceLowerBound(double look_ahead_distance, double l_self, double l_target);
 
