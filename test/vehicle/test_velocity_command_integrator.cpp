@@ -179,12 +179,12 @@ TEST(VelocityCommandIntegrator, RefusedInputsHoldTheAnchor) {
   EXPECT_FALSE(integrator.measure(vec(1.0), 0.0));  // one axis of two
   EXPECT_FALSE(integrator.measure(vec(1.0, 0.0), kInf));
   ASSERT_TRUE(integrator.measure(vec(1.0, 0.5), 0.0));
-  for (const auto& [a, T] : {std::pair<AxisVector, double>{vec(kNaN, 0.0), 0.1},
-                             {vec(1.0, 1.0), 0.0},
-                             {vec(1.0, 1.0), -0.1},
-                             {vec(1.0, 1.0), kInf},
-                             {vec(1.0), 0.1},
-                             {vec(1e308, 0.0), 1e10}}) {
+  // Each an acceleration and a period: NaN, T = 0, T < 0, T infinite, one axis of two, and an
+  // a h that overflows.
+  const std::pair<AxisVector, double> refused[] = {{vec(kNaN, 0.0), 0.1}, {vec(1.0, 1.0), 0.0},
+                                                   {vec(1.0, 1.0), -0.1}, {vec(1.0, 1.0), kInf},
+                                                   {vec(1.0), 0.1},       {vec(1e308, 0.0), 1e10}};
+  for (const auto& [a, T] : refused) {
     const VelocityCommand c = integrator.step(a, T, 0.0);
     EXPECT_TRUE(c.refused);
     EXPECT_MATRIX_NEAR(c.velocity, vec(1.0, 0.5), 0.0);
