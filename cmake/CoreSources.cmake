@@ -44,6 +44,7 @@ set(PCA_SCENARIO_SOURCES
 # projection_collision_avoidance_vehicle: the vehicle adapters' math (odometry pairs to a relative
 # state, the unicycle's look-ahead point, velocity commands, the output timeout); Eigen and std.
 set(PCA_VEHICLE_SOURCES
+  src/vehicle/CommandConverter.cpp
   src/vehicle/OutputWatchdog.cpp
   src/vehicle/RelativeStateFromOdometry.cpp
   src/vehicle/Rotation.cpp

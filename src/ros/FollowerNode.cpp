@@ -14,6 +14,7 @@
 #include "follower/FollowerOptions.hpp"
 #include "follower/FollowerOutputs.hpp"
 #include "follower/FollowerReconfigure.hpp"
+#include "follower/OdometryInput.hpp"
 
 namespace projection_collision_avoidance {
 
@@ -61,6 +62,15 @@ FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh,
         std::make_unique<FollowerOutputs>(nh, private_nh, name, options, parameters.control_rate,
                                           member, parameters.separation, inputs_.get());
     inputs_->start(nh);
+    if (options.input == MeasurementInput::kOdometry) {
+      odometry_input_ = std::make_unique<OdometryInput>(
+          name, options, parameters.model.double_integrator_axes,
+          [this](const RelativeMeasurement& msg) { inputs_->admitMeasurement(msg); });
+      outputs_->setMarkerOrigin([this](std::string* frame, Eigen::Vector3d* origin) {
+        return odometry_input_->controlledPoint(frame, origin);
+      });
+      odometry_input_->start(nh);
+    }
     reconfigure_ = std::make_unique<FollowerReconfigure>(private_nh, name, start, cycle_.get(),
                                                          outputs_.get());
     if (options.control_loop == ControlLoop::kThread) {
@@ -85,9 +95,10 @@ FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh,
   }
   ROS_INFO_STREAM(name << ": " << member.name << " looking at " << member.target_name << ", d = ["
                        << parameters.separation.transpose() << "], running at "
-                       << parameters.control_rate << " Hz (trigger: " << toString(options.trigger)
-                       << loop.str() << "), " << parameters.model.double_integrator_axes
-                       << " axes, xi_max " << start.xi_max << " m"
+                       << parameters.control_rate << " Hz (input: " << toString(options.input)
+                       << ", trigger: " << toString(options.trigger) << loop.str() << "), "
+                       << parameters.model.double_integrator_axes << " axes, xi_max "
+                       << start.xi_max << " m"
                        << (parameters.time_headway > 0.0
                                ? ", time headway " + std::to_string(parameters.time_headway) +
                                      " s from " + inputs_->odometryTopic()
@@ -102,6 +113,7 @@ void FollowerNode::stop() {
     outputs_->stopThread();
   }
   reconfigure_.reset();
+  odometry_input_.reset();
   inputs_.reset();  // no measurement's step after this
   outputs_.reset();
 }

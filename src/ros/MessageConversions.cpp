@@ -130,6 +130,17 @@ bool stateFromOdometryMsg(const nav_msgs::Odometry& msg, int axes, Eigen::Vector
   return true;
 }
 
+OdometrySample toOdometrySample(const nav_msgs::Odometry& msg) {
+  OdometrySample sample;
+  sample.stamp = msg.header.stamp.toSec();
+  tf2::fromMsg(msg.pose.pose.position, sample.position);
+  const geometry_msgs::Quaternion& q = msg.pose.pose.orientation;
+  sample.orientation = Eigen::Quaterniond(q.w, q.x, q.y, q.z);
+  tf2::fromMsg(msg.twist.twist.linear, sample.linear_velocity);
+  tf2::fromMsg(msg.twist.twist.angular, sample.angular_velocity);
+  return sample;
+}
+
 geometry_msgs::TransformStamped toTransformMsg(const Eigen::Ref<const Eigen::VectorXd>& position,
                                                const ros::Time& stamp, const std::string& parent,
                                                const std::string& child) {

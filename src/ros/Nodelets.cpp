@@ -8,6 +8,7 @@
 #include <pluginlib/class_list_macros.hpp>
 
 #include "projection_collision_avoidance/core/ParameterError.hpp"
+#include "projection_collision_avoidance/ros/CommandAdapter.hpp"
 #include "projection_collision_avoidance/ros/FollowerNode.hpp"
 #include "projection_collision_avoidance/ros/LeaderNode.hpp"
 #include "projection_collision_avoidance/ros/LinkRelay.hpp"
@@ -45,6 +46,7 @@ class FollowerNodelet : public NodeletOf<FollowerNode> {};
 class LeaderNodelet : public NodeletOf<LeaderNode> {};
 class PlantNodelet : public NodeletOf<PlantNode> {};
 class LinkRelayNodelet : public NodeletOf<LinkRelay> {};
+class CommandAdapterNodelet : public NodeletOf<CommandAdapter> {};
 
 }  // namespace projection_collision_avoidance
 
@@ -52,3 +54,4 @@ PLUGINLIB_EXPORT_CLASS(projection_collision_avoidance::FollowerNodelet, nodelet:
 PLUGINLIB_EXPORT_CLASS(projection_collision_avoidance::LeaderNodelet, nodelet::Nodelet)
 PLUGINLIB_EXPORT_CLASS(projection_collision_avoidance::PlantNodelet, nodelet::Nodelet)
 PLUGINLIB_EXPORT_CLASS(projection_collision_avoidance::LinkRelayNodelet, nodelet::Nodelet)
+PLUGINLIB_EXPORT_CLASS(projection_collision_avoidance::CommandAdapterNodelet, nodelet::Nodelet)

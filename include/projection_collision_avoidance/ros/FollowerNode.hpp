@@ -9,6 +9,7 @@ namespace projection_collision_avoidance {
 class FollowerCycle;
 class FollowerInputs;
 class FollowerLoop;
+class OdometryInput;
 class FollowerOutputs;
 class FollowerReconfigure;
 struct Scenario;
@@ -17,7 +18,8 @@ struct Scenario;
 ///
 /// The follower is member ~formation_index of the scenario's formation (layoutFormation()): it
 /// keeps the separation d_i of its slot to its target (the leader, or the follower ahead of it in
-/// a chain). Subscribes `relative_measurement` (RelativeMeasurement, x_target - x_i) and
+/// a chain). Subscribes `relative_measurement` (RelativeMeasurement, x_target - x_i; with
+/// ~input odometry instead its own `odom` and its target's `target_odom`, OdometryInput) and
 /// `leader_broadcast` (LeaderBroadcast of the target: monitored always, its acceleration u_1, plus
 /// pinv(B) u_d with controller.leader_information.disturbance, used with ~use_leader_broadcast)
 /// and, with a time headway (controller.spacing.time_headway > 0), `odom` (nav_msgs/Odometry:
@@ -66,11 +68,11 @@ struct Scenario;
 /// (mlockall); the node exits, naming the parameter, if the kernel refuses either.
 ///
 /// The parts, each with one job: FollowerInputs (subscriptions and input guards, writing the
-/// accepted inputs into lock-free slots), FollowerCycle (mode, period accounting, the core's
-/// step; no ROS), FollowerLoop (the timer or real-time thread that ticks the cycle),
-/// FollowerOutputs (messages, markers, diagnostics, log lines; a thread of its own behind a
-/// lock-free queue for the real-time loop) and FollowerReconfigure (dynamic_reconfigure). This
-/// class reads the parameters and wires them (doc/layout.md).
+/// accepted inputs into lock-free slots; OdometryInput with ~input odometry), FollowerCycle (mode,
+/// period accounting, the core's step; no ROS), FollowerLoop (the timer or real-time thread that
+/// ticks the cycle), FollowerOutputs (messages, markers, diagnostics, log lines; a thread of its
+/// own behind a lock-free queue for the real-time loop) and FollowerReconfigure
+/// (dynamic_reconfigure). This class reads the parameters and wires them (doc/layout.md).
 class FollowerNode {
  public:
   /// @throws ParameterError naming the parameter when the scenario or an option is invalid
@@ -86,6 +88,7 @@ class FollowerNode {
 
   std::unique_ptr<FollowerCycle> cycle_;
   std::unique_ptr<FollowerInputs> inputs_;
+  std::unique_ptr<OdometryInput> odometry_input_;  ///< ~input odometry only
   std::unique_ptr<FollowerOutputs> outputs_;
   std::unique_ptr<FollowerReconfigure> reconfigure_;
   std::unique_ptr<FollowerLoop> loop_;  ///< started last, stopped first

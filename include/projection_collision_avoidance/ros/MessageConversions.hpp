@@ -16,6 +16,7 @@
 
 #include "projection_collision_avoidance/LeaderBroadcast.h"
 #include "projection_collision_avoidance/RelativeMeasurement.h"
+#include "projection_collision_avoidance/vehicle/RelativeStateFromOdometry.hpp"
 
 namespace projection_collision_avoidance {
 
@@ -64,6 +65,10 @@ nav_msgs::Odometry toOdometryMsg(const Eigen::Ref<const Eigen::VectorXd>& state,
 
 /// The state [p; v] (2 axes entries) of an Odometry; false if non-finite.
 bool stateFromOdometryMsg(const nav_msgs::Odometry& msg, int axes, Eigen::VectorXd* state);
+
+/// An Odometry as the vehicle layer's OdometrySample (stamp, pose, twist as they are; the
+/// checks of finiteness and unit quaternions are RelativeStateFromOdometry's).
+OdometrySample toOdometrySample(const nav_msgs::Odometry& msg);
 
 /// Colour of a marker: red, green, blue, alpha in [0, 1].
 struct MarkerColor {

@@ -32,8 +32,11 @@ FollowerInputs::FollowerInputs(std::string node_name, const FollowerNodeOptions&
 }
 
 void FollowerInputs::start(ros::NodeHandle nh) {
-  measurement_subscriber_ = nh.subscribe("relative_measurement", 10, &FollowerInputs::onMeasurement,
-                                         this, ros::TransportHints().tcpNoDelay());
+  if (options_.input == MeasurementInput::kRelativeMeasurement) {
+    measurement_subscriber_ =
+        nh.subscribe("relative_measurement", 10, &FollowerInputs::onMeasurement, this,
+                     ros::TransportHints().tcpNoDelay());
+  }
   leader_subscriber_ =
       nh.subscribe("leader_broadcast", 10, &FollowerInputs::onLeaderBroadcast, this);
   if (design_.parameters.time_headway > 0.0) {
@@ -78,6 +81,11 @@ bool FollowerInputs::admitHeader(InputGuard& guard, ClockWatch& clock, Heard& he
 }
 
 void FollowerInputs::onMeasurement(const RelativeMeasurement::ConstPtr& msg) {
+  admitMeasurement(*msg);
+}
+
+void FollowerInputs::admitMeasurement(const RelativeMeasurement& measurement) {
+  const RelativeMeasurement* msg = &measurement;
   admitGuarded(measurement_guard_, name_, [&] {
     const ros::Time now = ros::Time::now();
     if (!admitHeader(measurement_guard_, measurement_clock_, measurement_heard_, msg->header,

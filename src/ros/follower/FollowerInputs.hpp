@@ -33,7 +33,8 @@ struct FollowerInputStats {
   double leader_age = -1.0;  ///< s, of the last accepted leader broadcast; -1: none
 };
 
-/// The follower's inputs: subscribes `relative_measurement`, `leader_broadcast` and, with a time
+/// The follower's inputs: subscribes `relative_measurement` (with ~input relative_measurement;
+/// other inputs hand their measurements to admitMeasurement()), `leader_broadcast` and, with a time
 /// headway (time_headway > 0), `odom` (nav_msgs/Odometry: its own state; frame ~odom_frame,
 /// refused once older than ~measurement_timeout on arrival), judges each message with its
 /// InputGuard (doc/boundary.md) on the subscriber's thread, and writes what it accepts into the
@@ -54,6 +55,11 @@ class FollowerInputs {
   void start(ros::NodeHandle nh);
   /// The own odometry's topic ("" without a time headway), once started.
   std::string odometryTopic() const { return odometry_subscriber_.getTopic(); }
+
+  /// Judges a relative measurement (from the subscription, or made by an input adapter such as
+  /// OdometryInput) and, if accepted, writes it into the cycle (and, with ~trigger measurement,
+  /// runs its step). One caller at a time.
+  void admitMeasurement(const RelativeMeasurement& msg);
 
   /// Refusal counts, latest reasons and the inputs' ages at ROS time @p now_ns (any thread).
   FollowerInputStats stats(std::int64_t now_ns) const;

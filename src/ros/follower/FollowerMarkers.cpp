@@ -13,17 +13,26 @@ namespace projection_collision_avoidance {
 void FollowerOutputs::publishMarkers(const FollowerCycleOutput& out) {
   using visualization_msgs::Marker;
   const DynamicFollowerStatus& s = out.status;
-  const std::string& frame = options_.follower_frame;
+  std::string frame = options_.follower_frame;
+  // The controlled point: the follower frame's origin, or where the input says it is (the
+  // look-ahead point of ~input odometry, in the world frame).
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  if (marker_origin_ && !marker_origin_(&frame, &centre)) {
+    return;
+  }
   const ros::Time now = rosTimeOf(out.stamp_ns);
   const Eigen::Index axes = separation_.size() / 2;
   const GenericDimensions::StateVector& xi = out.xi;
   const bool inside_perimeter = out.distance < out.perimeter;
   visualization_msgs::MarkerArray markers;
-  // Safety perimeter alpha ||d|| around the follower: green, red once the leader is inside.
+  // The controlled point: the follower frame's origin, or the look-ahead point of ~input
+  // odometry (~odometry/look_ahead along the body x axis), around which the perimeter is kept.
+  const Eigen::Vector3d centre(
+      options_.input == MeasurementInput::kOdometry ? options_.odometry.look_ahead : 0.0, 0.0, 0.0);
+  // Safety perimeter alpha ||d|| around it: green, red once the target is inside.
   // A flat disc on the ground plane (a sphere in 3-D), so the markers above it stay visible.
   visualization_msgs::Marker perimeter =
-      toMarker(frame, now, "perimeter", member_.index, Marker::SPHERE, Eigen::Vector3d::Zero(),
-               2.0 * out.perimeter,
+      toMarker(frame, now, "perimeter", member_.index, Marker::SPHERE, centre, 2.0 * out.perimeter,
                {inside_perimeter ? 1.0F : 0.1F, inside_perimeter ? 0.1F : 0.8F, 0.1F, 0.35F});
   if (axes < 3) {
     perimeter.type = Marker::CYLINDER;
@@ -32,8 +41,9 @@ void FollowerOutputs::publishMarkers(const FollowerCycleOutput& out) {
   markers.markers.push_back(perimeter);
   // The slot x_1 - d, relative to the follower: (p_1 - p_2) - d_p.
   const Eigen::VectorXd slot = xi.head(axes);
-  visualization_msgs::Marker slot_marker = toMarker(frame, now, "slot", member_.index, Marker::CUBE,
-                                                    toVector3(slot), 0.3, {0.8F, 0.8F, 0.8F, 0.9F});
+  visualization_msgs::Marker slot_marker =
+      toMarker(frame, now, "slot", member_.index, Marker::CUBE, centre + toVector3(slot), 0.3,
+               {0.8F, 0.8F, 0.8F, 0.9F});
   markers.markers.push_back(slot_marker);
   // The follower where the CF estimate puts it: p_2 + (xi - xi_hat)_p. Grey in the fallback,
   // where xi is the last measured one and xi_hat a prediction.
@@ -42,12 +52,12 @@ void FollowerOutputs::publishMarkers(const FollowerCycleOutput& out) {
   const MarkerColor ghost_color =
       fallback ? MarkerColor{0.5F, 0.5F, 0.5F, 0.45F} : MarkerColor{1.0F, 0.55F, 0.0F, 0.45F};
   markers.markers.push_back(toMarker(frame, now, "cf_estimate", member_.index, Marker::SPHERE,
-                                     toVector3(ghost), 0.5, ghost_color));
+                                     centre + toVector3(ghost), 0.5, ghost_color));
   // ||xi|| against xi_max, as text above the follower; the mode unless tracking.
   const float shade = xi.norm() > out.xi_max || fallback ? 0.2F : 1.0F;  // red: trouble
   visualization_msgs::Marker text =
       toMarker(frame, now, "bound", member_.index, Marker::TEXT_VIEW_FACING,
-               Eigen::Vector3d(0.0, 0.0, 1.2), 0.35, {1.0F, shade, shade, 1.0F});
+               centre + Eigen::Vector3d(0.0, 0.0, 1.2), 0.35, {1.0F, shade, shade, 1.0F});
   std::ostringstream label;
   label << std::fixed << std::setprecision(2) << "|xi| " << xi.norm() << " / xi_max " << out.xi_max
         << " m";

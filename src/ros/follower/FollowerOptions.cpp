@@ -33,6 +33,37 @@ ControlLoop controlLoopOf(const std::string& value, bool sim_time) {
   throw ParameterError("~control_loop", "must be \"timer\" or \"thread\", got \"" + value + "\"");
 }
 
+MeasurementInput inputOf(const std::string& value) {
+  for (const MeasurementInput input :
+       {MeasurementInput::kRelativeMeasurement, MeasurementInput::kOdometry}) {
+    if (value == toString(input)) {
+      return input;
+    }
+  }
+  throw ParameterError("~input",
+                       "must be \"relative_measurement\" or \"odometry\", got \"" + value + "\"");
+}
+
+OdometryInputOptions readOdometryOptions(NodeOptionReader& reader) {
+  OdometryInputOptions o;
+  o.max_skew = reader.number("odometry/max_skew", o.max_skew, 0.0, 3600.0);
+  o.quaternion_tolerance =
+      reader.number("odometry/quaternion_tolerance", o.quaternion_tolerance, 0.0, 1.0);
+  const std::string frame = reader.text("odometry/twist_frame", "body");
+  if (frame != "body" && frame != "header") {
+    throw ParameterError("~odometry/twist_frame",
+                         "must be \"body\" (child_frame_id, REP 105) or \"header\" "
+                         "(header.frame_id), got \"" +
+                             frame + "\"");
+  }
+  o.twist_in_body_frame = frame == "body";
+  o.look_ahead = reader.number("odometry/look_ahead", o.look_ahead, 0.0, 1000.0);
+  o.target_look_ahead =
+      reader.number("odometry/target_look_ahead", o.target_look_ahead, 0.0, 1000.0);
+  o.tf_timeout = reader.number("odometry/tf_timeout", o.tf_timeout, 0.0, 10.0);
+  return o;
+}
+
 }  // namespace
 
 /// Member ~formation_index of the scenario's formation.
@@ -80,11 +111,25 @@ FollowerNodeOptions readFollowerOptions(NodeOptionReader& reader, const Controll
                              "~control_loop to \"thread\", or this to 0");
   }
   options.lock_memory = reader.boolean("lock_memory", options.lock_memory);
+  options.input = inputOf(reader.text("input", toString(options.input)));
+  if (options.input == MeasurementInput::kOdometry) {
+    options.odometry = readOdometryOptions(reader);
+  }
   return options;
 }
 
 const char* toString(ControlTrigger trigger) {
   return trigger == ControlTrigger::kMeasurement ? "measurement" : "timer";
+}
+
+const char* toString(MeasurementInput input) {
+  switch (input) {
+    case MeasurementInput::kOdometry:
+      return "odometry";
+    case MeasurementInput::kRelativeMeasurement:
+    default:
+      return "relative_measurement";
+  }
 }
 
 const char* toString(ControlLoop loop) { return loop == ControlLoop::kThread ? "thread" : "timer"; }

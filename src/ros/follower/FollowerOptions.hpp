@@ -28,6 +28,25 @@ enum class ControlLoop : std::uint8_t {
 /// "timer" or "thread".
 const char* toString(ControlLoop loop);
 
+/// Where the relative measurement comes from (~input).
+enum class MeasurementInput : std::uint8_t {
+  kRelativeMeasurement,  ///< "relative_measurement": the package's RelativeMeasurement
+  kOdometry,             ///< "odometry": the own `odom` and the target's `target_odom`
+};
+
+/// "relative_measurement" or "odometry".
+const char* toString(MeasurementInput input);
+
+/// The odometry input's options (~odometry/...; doc/vehicles.md).
+struct OdometryInputOptions {
+  double max_skew = 0.05;              ///< s; largest |t_target - t_self| aligned
+  double quaternion_tolerance = 1e-2;  ///< largest |norm(q) - 1| normalised
+  bool twist_in_body_frame = true;     ///< twist in child_frame_id (REP 105), else header frame
+  double look_ahead = 0.0;             ///< m; l of the own controlled point (unicycle), 0: origin
+  double target_look_ahead = 0.0;      ///< m; the target's
+  double tf_timeout = 0.0;             ///< s a tf lookup of another frame may wait
+};
+
 /// Highest ~control_priority (SCHED_FIFO's highest priority on Linux).
 constexpr int kMaxControlPriority = 99;
 
@@ -50,6 +69,9 @@ struct FollowerNodeOptions {
   /// ~control_priority: SCHED_FIFO priority of the control thread, 1 to 99; 0 (default) leaves
   /// the scheduler alone. Only with control_loop "thread".
   int control_priority = 0;
+  /// ~input: the relative measurement's source (default: the RelativeMeasurement topic).
+  MeasurementInput input = MeasurementInput::kRelativeMeasurement;
+  OdometryInputOptions odometry;  ///< ~odometry/...: only with input "odometry"
   /// ~lock_memory: mlockall(MCL_CURRENT | MCL_FUTURE) at start (default false).
   bool lock_memory = false;
 };
@@ -59,8 +81,8 @@ struct FollowerNodeOptions {
 FormationMember memberOf(NodeOptionReader& reader, const Scenario& scenario);
 
 /// The follower node's options from its private namespace, each validated (the message names
-/// the key): ranges, ~trigger, ~control_loop ("thread" refused under simulated time, @p sim_time),
-/// ~control_priority only with the thread loop.
+/// the key): ranges, ~input (and ~odometry/...), ~trigger, ~control_loop ("thread" refused under
+/// simulated time, @p sim_time), ~control_priority only with the thread loop.
 FollowerNodeOptions readFollowerOptions(NodeOptionReader& reader, const ControllerParameters& p,
                                         const FormationMember& member, bool sim_time);
 

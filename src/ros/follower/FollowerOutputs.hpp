@@ -54,6 +54,11 @@ class FollowerOutputs {
   void startThread(std::function<void()> idle);
   /// Stops and joins that thread (publishing what is queued first).
   void stopThread();
+  /// Where the markers go: @p origin gives the frame and the position in it of the follower's
+  /// controlled point (false while unknown). Without one: ~follower_frame's origin. Set it
+  /// before the first output.
+  using MarkerOrigin = std::function<bool(std::string* frame, Eigen::Vector3d* origin)>;
+  void setMarkerOrigin(MarkerOrigin origin) { marker_origin_ = std::move(origin); }
   /// The tracker gain G_e in force, for the diagnostics (any thread).
   void describeTrackerGain(const Eigen::MatrixXd& gain);
   /// Outputs dropped because the queue was full (a queue this size never fills at the control
@@ -72,6 +77,7 @@ class FollowerOutputs {
   Eigen::VectorXd separation_;
   const FollowerInputs* inputs_;
   std::uint64_t steps_per_marker_ = 0;
+  MarkerOrigin marker_origin_;
 
   std::mutex publish_mutex_;    ///< publish(): the timer's or outputs' thread vs a measurement's
   FollowerCycleOutput latest_;  ///< the latest step, with the counters of the latest output

@@ -1,0 +1,71 @@
+#pragma once
+
+#include <memory>
+#include <mutex>
+#include <string>
+
+#include <geometry_msgs/AccelStamped.h>
+#include <nav_msgs/Odometry.h>
+#include <ros/ros.h>
+
+#include "projection_collision_avoidance/ros/InputAdmission.hpp"
+#include "projection_collision_avoidance/ros/InputGuard.hpp"
+#include "projection_collision_avoidance/vehicle/CommandConverter.hpp"
+#include "projection_collision_avoidance/vehicle/OutputWatchdog.hpp"
+
+namespace projection_collision_avoidance {
+
+struct CommandAdapterOptions;
+
+/// The follower's command for a vehicle stack (node `command_adapter`, nodelet
+/// CommandAdapterNodelet; doc/vehicles.md). Subscribes `command` (geometry_msgs/AccelStamped:
+/// the follower's acceleration, world frame) and the vehicle's own `odom` (nav_msgs/Odometry:
+/// heading and measured velocity, twist in child_frame_id as REP 105 says) and publishes, for
+/// each command, the ~outputs chosen: `setpoint_accel` (geometry_msgs/Vector3Stamped, the
+/// acceleration in the command's frame, ENU as MAVROS's setpoint_accel plugin takes it),
+/// `cmd_vel` (geometry_msgs/Twist: the velocity command, world or base frame, or a unicycle's
+/// v and ω) and `cmd_vel_stamped` (geometry_msgs/TwistStamped). CommandConverter makes them.
+///
+/// Command timeout: a steady-clock timer at ~watchdog_rate checks OutputWatchdog; once no
+/// command has come for ~command_timeout (the follower stopped, crashed, or its simulated clock
+/// stands still) every output gets its stop (zero velocity, zero v and ω, a braking
+/// acceleration), again at every check until commands return. Commands that are non-finite, act
+/// on an axis the model lacks, or are stamped 0, in the future or not after the last one, are
+/// refused and counted (InputGuard); so are non-finite odometry messages. No input ends the node.
+class CommandAdapter {
+ public:
+  /// @throws ParameterError naming the key of an invalid option
+  CommandAdapter(ros::NodeHandle nh, ros::NodeHandle private_nh);
+  ~CommandAdapter();
+  CommandAdapter(const CommandAdapter&) = delete;
+  CommandAdapter& operator=(const CommandAdapter&) = delete;
+
+ private:
+  void onCommand(const geometry_msgs::AccelStamped::ConstPtr& msg);
+  void onOdometry(const nav_msgs::Odometry::ConstPtr& msg);
+  void onWatchdog(const ros::SteadyTimerEvent& event);
+  /// Publishes @p command on every chosen output, stamped @p stamp (mutex_ held).
+  void publish(const ConvertedCommand& command, const ros::Time& stamp);
+
+  std::string name_;
+  std::unique_ptr<CommandAdapterOptions> options_;
+  std::mutex mutex_;  ///< the callbacks may run at once (nodelets)
+  CommandConverter converter_;
+  OutputWatchdog watchdog_;
+  InputGuard command_guard_;
+  ClockWatch command_clock_;
+  InputGuard odometry_guard_;
+  ClockWatch odometry_clock_;
+  std::string command_frame_;  ///< frame_id of the latest accepted command
+  std::string base_frame_;     ///< ~base_frame, or the own odometry's child_frame_id
+  Eigen::VectorXd acceleration_;
+
+  ros::Publisher accel_publisher_;
+  ros::Publisher twist_publisher_;
+  ros::Publisher twist_stamped_publisher_;
+  ros::Subscriber command_subscriber_;
+  ros::Subscriber odometry_subscriber_;
+  ros::SteadyTimer watchdog_timer_;
+};
+
+}  // namespace projection_collision_avoidance

@@ -1,0 +1,171 @@
+#include "projection_collision_avoidance/ros/CommandAdapter.hpp"
+
+#include <chrono>
+#include <utility>
+
+#include <geometry_msgs/Twist.h>
+#include <geometry_msgs/TwistStamped.h>
+#include <geometry_msgs/Vector3Stamped.h>
+
+#include "projection_collision_avoidance/ros/MessageConversions.hpp"
+#include "projection_collision_avoidance/ros/RosParameters.hpp"
+
+#include "adapter/CommandAdapterOptions.hpp"
+
+namespace projection_collision_avoidance {
+namespace {
+
+/// Steady (monotonic) time in s, the watchdog's clock.
+double steadySeconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+std::unique_ptr<CommandAdapterOptions> readOptions(const ros::NodeHandle& private_nh) {
+  NodeOptionReader reader(private_nh);
+  auto options = std::make_unique<CommandAdapterOptions>(readCommandAdapterOptions(reader));
+  reader.echo(private_nh.getNamespace());
+  return options;
+}
+
+geometry_msgs::Vector3 toVector3Msg(const Eigen::Vector3d& v) {
+  geometry_msgs::Vector3 msg;
+  msg.x = v.x();
+  msg.y = v.y();
+  msg.z = v.z();
+  return msg;
+}
+
+}  // namespace
+
+CommandAdapter::CommandAdapter(ros::NodeHandle nh, ros::NodeHandle private_nh)
+    : name_(private_nh.getNamespace()),
+      options_(readOptions(private_nh)),
+      converter_(options_->converter),
+      watchdog_(options_->command_timeout),
+      command_guard_("command", {"", 0.1, options_->command_timeout}),
+      odometry_guard_("odom", {"", 0.1, 0.0}),
+      base_frame_(options_->base_frame),
+      acceleration_(Eigen::VectorXd::Zero(options_->converter.axes)) {
+  if (options_->accel_enu) {
+    accel_publisher_ = nh.advertise<geometry_msgs::Vector3Stamped>("setpoint_accel", 10);
+  }
+  if (options_->twist || options_->unicycle) {
+    twist_publisher_ = nh.advertise<geometry_msgs::Twist>("cmd_vel", 10);
+  }
+  if (options_->twist_stamped) {
+    twist_stamped_publisher_ = nh.advertise<geometry_msgs::TwistStamped>("cmd_vel_stamped", 10);
+  }
+  odometry_subscriber_ = nh.subscribe("odom", 10, &CommandAdapter::onOdometry, this,
+                                      ros::TransportHints().tcpNoDelay());
+  command_subscriber_ = nh.subscribe("command", 10, &CommandAdapter::onCommand, this,
+                                     ros::TransportHints().tcpNoDelay());
+  watchdog_timer_ = nh.createSteadyTimer(ros::WallDuration(1.0 / options_->watchdog_rate),
+                                         &CommandAdapter::onWatchdog, this);
+  ROS_INFO_STREAM(name_ << ": " << (options_->accel_enu ? "setpoint_accel " : "")
+                        << (options_->twist ? "cmd_vel (velocity) " : "")
+                        << (options_->unicycle ? "cmd_vel (unicycle) " : "")
+                        << (options_->twist_stamped ? "cmd_vel_stamped " : "")
+                        << "from command, stop after " << options_->command_timeout
+                        << " s without one");
+}
+
+CommandAdapter::~CommandAdapter() {
+  watchdog_timer_.stop();
+  command_subscriber_.shutdown();
+  odometry_subscriber_.shutdown();
+}
+
+void CommandAdapter::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  admitGuarded(odometry_guard_, name_, [&] {
+    const ros::Time now = ros::Time::now();
+    if (odometry_clock_.wentBack(now)) {
+      odometry_guard_.restartTimeline();
+    }
+    if (!checkHeader(odometry_guard_, msg->header, now)) {
+      return;
+    }
+    if (!converter_.observe(toOdometrySample(*msg))) {
+      odometry_guard_.reject(Rejection::kContent,
+                             "non-finite field or an orientation that is not a unit quaternion");
+      return;
+    }
+    odometry_guard_.accept(nanosecondsOf(msg->header.stamp), nanosecondsOf(now));
+    if (options_->base_frame.empty()) {
+      base_frame_ = msg->child_frame_id;
+    }
+  });
+}
+
+void CommandAdapter::onCommand(const geometry_msgs::AccelStamped::ConstPtr& msg) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  admitGuarded(command_guard_, name_, [&] {
+    const ros::Time now = ros::Time::now();
+    if (command_clock_.wentBack(now)) {
+      command_guard_.restartTimeline();
+      watchdog_.reset();
+    }
+    if (!checkHeader(command_guard_, msg->header, now)) {
+      return;
+    }
+    std::string why;
+    if (!commandFromAccelMsg(*msg, options_->converter.axes, &acceleration_, &why)) {
+      command_guard_.reject(Rejection::kContent, why);
+      return;
+    }
+    command_guard_.accept(nanosecondsOf(msg->header.stamp), nanosecondsOf(now));
+    command_frame_ = msg->header.frame_id;
+    const ConvertedCommand& command = converter_.convert(acceleration_, now.toSec());
+    if (!command.heading_known) {
+      ROS_WARN_STREAM_THROTTLE(5.0, name_ << ": no fresh own odometry (odom) for the heading: "
+                                             "sending the stop");
+    }
+    watchdog_.commandSent(steadySeconds());
+    publish(command, msg->header.stamp);
+  });
+}
+
+void CommandAdapter::onWatchdog(const ros::SteadyTimerEvent& /*event*/) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  const WatchdogDecision decision = watchdog_.check(steadySeconds());
+  if (!decision.send_stop) {
+    return;
+  }
+  if (decision.stop_began) {
+    ROS_WARN_STREAM(name_ << ": no command for " << options_->command_timeout << " s ("
+                          << toString(decision.state) << "): sending the stop");
+  }
+  const ros::Time now = ros::Time::now();
+  publish(converter_.stop(now.toSec()), now);
+}
+
+void CommandAdapter::publish(const ConvertedCommand& command, const ros::Time& stamp) {
+  if (options_->accel_enu) {
+    geometry_msgs::Vector3Stamped accel;
+    accel.header.stamp = stamp;
+    accel.header.frame_id = command_frame_;
+    accel.vector = toVector3Msg(command.acceleration);
+    accel_publisher_.publish(accel);
+  }
+  geometry_msgs::Twist twist;
+  if (options_->unicycle) {
+    twist.linear.x = command.unicycle.velocity.v;
+    twist.angular.z = command.unicycle.velocity.omega;
+  } else {
+    twist.linear = toVector3Msg(command.velocity);
+  }
+  if (options_->twist || options_->unicycle) {
+    twist_publisher_.publish(twist);
+  }
+  if (options_->twist_stamped) {
+    geometry_msgs::TwistStamped stamped;
+    stamped.header.stamp = stamp;
+    stamped.header.frame_id = options_->unicycle || options_->converter.velocity_in_base_frame
+                                  ? base_frame_
+                                  : command_frame_;
+    stamped.twist = twist;
+    twist_stamped_publisher_.publish(stamped);
+  }
+}
+
+}  // namespace projection_collision_avoidance

@@ -1,0 +1,96 @@
+#include "adapter/CommandAdapterOptions.hpp"
+
+#include <limits>
+#include <sstream>
+
+#include "projection_collision_avoidance/core/ParameterError.hpp"
+
+namespace projection_collision_avoidance {
+namespace {
+
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+/// A limit where 0 means none (infinity).
+double limitOrNone(NodeOptionReader& reader, const std::string& key, double max) {
+  const double value = reader.number(key, 0.0, 0.0, max);
+  return value > 0.0 ? value : kInfinity;
+}
+
+/// "body" or "header" (~odometry/twist_frame).
+TwistFrame twistFrameOf(const std::string& value) {
+  if (value == "body") {
+    return TwistFrame::kBody;
+  }
+  if (value == "header") {
+    return TwistFrame::kWorld;
+  }
+  throw ParameterError(
+      "~odometry/twist_frame",
+      "must be \"body\" (child_frame_id, REP 105) or \"header\", got \"" + value + "\"");
+}
+
+void readOutputs(NodeOptionReader& reader, CommandAdapterOptions* options) {
+  std::istringstream words(reader.text("outputs", "twist"));
+  std::string word;
+  int count = 0;
+  while (words >> word) {
+    ++count;
+    if (word == "accel_enu") {
+      options->accel_enu = true;
+    } else if (word == "twist") {
+      options->twist = true;
+    } else if (word == "twist_stamped") {
+      options->twist_stamped = true;
+    } else if (word == "unicycle") {
+      options->unicycle = true;
+    } else {
+      throw ParameterError("~outputs", "\"" + word +
+                                           "\" is not one of accel_enu, twist, twist_stamped, "
+                                           "unicycle");
+    }
+  }
+  if (count == 0) {
+    throw ParameterError("~outputs",
+                         "names no output: give one or more of accel_enu, twist, "
+                         "twist_stamped, unicycle");
+  }
+  if (options->twist && options->unicycle) {
+    throw ParameterError("~outputs", "has both twist and unicycle, which both publish cmd_vel");
+  }
+}
+
+}  // namespace
+
+CommandAdapterOptions readCommandAdapterOptions(NodeOptionReader& reader) {
+  CommandAdapterOptions options;
+  readOutputs(reader, &options);
+  CommandConverterOptions& c = options.converter;
+  c.axes = reader.integer("axes", c.axes, 2, 3);
+  c.period = 1.0 / reader.number("control_rate", 1.0 / c.period, 1e-3, 1e5);
+  options.command_timeout =
+      reader.number("command_timeout", options.command_timeout, c.period, 3600.0);
+  options.watchdog_rate = reader.number("watchdog_rate", options.watchdog_rate, 0.1, 1e4);
+  c.max_odometry_age = reader.number("odometry/max_age", c.max_odometry_age, 0.0, 3600.0);
+  c.odometry_twist_frame = twistFrameOf(reader.text("odometry/twist_frame", "body"));
+  c.velocity.max_speed = limitOrNone(reader, "velocity/max_speed", 1e4);
+  c.velocity.velocity_lag = reader.number("velocity/lag", 0.0, 0.0, 3600.0);
+  c.velocity.max_measurement_age = c.max_odometry_age;
+  const std::string frame = reader.text("velocity/frame", "world");
+  if (frame != "world" && frame != "base") {
+    throw ParameterError("~velocity/frame", "must be \"world\" or \"base\", got \"" + frame + "\"");
+  }
+  c.velocity_in_base_frame = frame == "base";
+  c.unicycle = options.unicycle;
+  if (c.unicycle && c.axes != 2) {
+    throw ParameterError(
+        "~axes", "is " + std::to_string(c.axes) + " but the unicycle output is planar: set 2");
+  }
+  c.look_ahead = reader.number("unicycle/look_ahead", c.look_ahead, 1e-3, 100.0);
+  c.unicycle_limits.max_speed = limitOrNone(reader, "unicycle/max_speed", 1e4);
+  c.unicycle_limits.max_yaw_rate = limitOrNone(reader, "unicycle/max_yaw_rate", 1e4);
+  c.stop_deceleration = reader.number("stop_deceleration", c.stop_deceleration, 1e-3, 1e3);
+  options.base_frame = reader.text("base_frame", "");
+  return options;
+}
+
+}  // namespace projection_collision_avoidance

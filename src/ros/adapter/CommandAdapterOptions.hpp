@@ -1,0 +1,30 @@
+#pragma once
+
+#include <string>
+
+#include "projection_collision_avoidance/ros/RosParameters.hpp"
+#include "projection_collision_avoidance/vehicle/CommandConverter.hpp"
+
+namespace projection_collision_avoidance {
+
+/// The command adapter's options, read once from its private namespace (doc/vehicles.md).
+struct CommandAdapterOptions {
+  bool accel_enu = false;      ///< ~outputs has "accel_enu": `setpoint_accel` (Vector3Stamped)
+  bool twist = false;          ///< "twist": `cmd_vel` (Twist), the velocity command
+  bool twist_stamped = false;  ///< "twist_stamped": `cmd_vel_stamped` (TwistStamped)
+  bool unicycle = false;       ///< "unicycle": `cmd_vel` (Twist: linear.x = v, angular.z = ω)
+  CommandConverterOptions converter;
+  double command_timeout = 0.25;  ///< steady s without a command before the stop is sent
+  double watchdog_rate = 20.0;    ///< Hz (steady time) of the timeout checks and repeated stops
+  std::string base_frame;  ///< frame_id of base-frame stamped outputs ("": the odometry's child)
+};
+
+/// The options, each validated (the message names the key): ~outputs (a space-separated set of
+/// accel_enu, twist, twist_stamped, unicycle; twist and unicycle both publish cmd_vel and are
+/// refused together), ~axes, ~control_rate, ~command_timeout, ~watchdog_rate,
+/// ~odometry/max_age, ~odometry/twist_frame, ~velocity/max_speed, ~velocity/lag,
+/// ~velocity/frame, ~unicycle/look_ahead, ~unicycle/max_speed, ~unicycle/max_yaw_rate,
+/// ~stop_deceleration, ~base_frame.
+CommandAdapterOptions readCommandAdapterOptions(NodeOptionReader& reader);
+
+}  // namespace projection_collision_avoidance

@@ -1,0 +1,160 @@
+#include "follower/OdometryInput.hpp"
+
+#include <cmath>
+#include <limits>
+#include <utility>
+
+#include <Eigen/Geometry>
+#include <tf2/exceptions.h>
+#include <tf2_eigen/tf2_eigen.h>
+
+#include "projection_collision_avoidance/ros/MessageConversions.hpp"
+
+namespace projection_collision_avoidance {
+namespace {
+
+OdometryAlignmentOptions alignmentOptions(const OdometryInputOptions& o, int axes) {
+  OdometryAlignmentOptions a;
+  a.axes = axes;
+  a.max_skew = o.max_skew;
+  a.quaternion_tolerance = o.quaternion_tolerance;
+  // A twist in the header frame is rotated into the world frame with the pose (toWorld()).
+  a.twist_frame = o.twist_in_body_frame ? TwistFrame::kBody : TwistFrame::kWorld;
+  a.self_point = Eigen::Vector3d(o.look_ahead, 0.0, 0.0);
+  a.target_point = Eigen::Vector3d(o.target_look_ahead, 0.0, 0.0);
+  return a;
+}
+
+}  // namespace
+
+OdometryInput::OdometryInput(std::string node_name, const FollowerNodeOptions& options, int axes,
+                             Sink sink)
+    : name_(std::move(node_name)),
+      options_(options),
+      axes_(axes),
+      sink_(std::move(sink)),
+      relative_(alignmentOptions(options.odometry, axes)),
+      world_frame_(options.measurement_frame),
+      skew_(std::numeric_limits<double>::quiet_NaN()) {
+  // A message older than the measurement timeout on arrival could only be stale.
+  self_.guard = InputGuard(
+      "odom", {options.odom_frame, options.max_future_stamp, options.measurement_timeout});
+  target_.guard =
+      InputGuard("target_odom", {"", options.max_future_stamp, options.measurement_timeout});
+  pair_guard_ = InputGuard("odometry pair", {"", options.max_future_stamp, 3600.0});
+}
+
+void OdometryInput::start(ros::NodeHandle nh) {
+  tf_listener_ = std::make_unique<tf2_ros::TransformListener>(tf_buffer_, nh);
+  self_subscriber_ = nh.subscribe<nav_msgs::Odometry>(
+      "odom", 10, [this](const nav_msgs::Odometry::ConstPtr& msg) { onOdometry(&self_, msg); },
+      ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
+  target_subscriber_ = nh.subscribe<nav_msgs::Odometry>(
+      "target_odom", 10,
+      [this](const nav_msgs::Odometry::ConstPtr& msg) { onOdometry(&target_, msg); },
+      ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
+}
+
+void OdometryInput::onOdometry(Side* side, const nav_msgs::Odometry::ConstPtr& msg) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  const std::uint64_t before = side->guard.rejected();
+  admitGuarded(side->guard, name_, [&] {
+    const ros::Time now = ros::Time::now();
+    if (side->clock.wentBack(now)) {  // both sides forget the old timeline
+      self_.guard.restartTimeline();
+      target_.guard.restartTimeline();
+      self_.have = target_.have = false;
+    }
+    if (!checkHeader(side->guard, msg->header, now)) {
+      return;
+    }
+    if (side == &self_ && world_frame_.empty()) {
+      world_frame_ = msg->header.frame_id;  // the own odometry's frame is the world
+    }
+    std::string why;
+    OdometrySample sample;
+    if (!toWorld(*msg, &sample, &why)) {
+      side->guard.reject(Rejection::kContent, why);
+      return;
+    }
+    side->guard.accept(nanosecondsOf(msg->header.stamp), nanosecondsOf(now));
+    side->sample = sample;
+    side->stamp = msg->header.stamp;
+    side->have = true;
+    if (side == &self_) {
+      const std::lock_guard<std::mutex> point_lock(point_mutex_);
+      point_ =
+          bodyPointState(sample, relative_.options().self_point, relative_.options().twist_frame)
+              .head<3>();
+      world_frame_copy_ = world_frame_;
+      have_point_ = true;
+    }
+    combine();
+  });
+  rejected_.fetch_add(side->guard.rejected() - before, std::memory_order_relaxed);
+}
+
+bool OdometryInput::toWorld(const nav_msgs::Odometry& msg, OdometrySample* sample,
+                            std::string* why) {
+  *sample = toOdometrySample(msg);
+  if (msg.header.frame_id == world_frame_ || world_frame_.empty()) {
+    return true;
+  }
+  geometry_msgs::TransformStamped transform;
+  try {
+    transform = tf_buffer_.lookupTransform(world_frame_, msg.header.frame_id, msg.header.stamp,
+                                           ros::Duration(options_.odometry.tf_timeout));
+  } catch (const tf2::TransformException& error) {
+    *why = "no transform from \"" + msg.header.frame_id.substr(0, InputGuard::kMaxQuotedLength) +
+           "\" to \"" + world_frame_ + "\": " + error.what();
+    return false;
+  }
+  const Eigen::Isometry3d world_from_frame = tf2::transformToEigen(transform);
+  const Eigen::Matrix3d rotation = world_from_frame.rotation();
+  sample->position = world_from_frame * sample->position;
+  sample->orientation = Eigen::Quaterniond(rotation) * sample->orientation;
+  if (!options_.odometry.twist_in_body_frame) {  // a twist in the header frame turns with it
+    sample->linear_velocity = rotation * sample->linear_velocity;
+    sample->angular_velocity = rotation * sample->angular_velocity;
+  }
+  return true;
+}
+
+bool OdometryInput::controlledPoint(std::string* frame, Eigen::Vector3d* point) {
+  const std::lock_guard<std::mutex> lock(point_mutex_);
+  if (!have_point_) {
+    return false;
+  }
+  *frame = world_frame_copy_;
+  *point = point_;
+  return true;
+}
+
+void OdometryInput::combine() {
+  if (!self_.have || !target_.have) {
+    return;
+  }
+  const RelativeOdometryResult result = relative_.compute(self_.sample, target_.sample);
+  if (!result.accepted()) {
+    rejected_pairs_.fetch_add(1, std::memory_order_relaxed);
+    pair_guard_.reject(Rejection::kContent,
+                       std::string("the odometry pair is refused: ") + toString(result.verdict) +
+                           (result.verdict == OdometryVerdict::kSkewTooLarge
+                                ? " (" + std::to_string(result.skew) + " s > ~odometry/max_skew)"
+                                : std::string()));
+    logRejection(pair_guard_, name_);
+    return;
+  }
+  skew_.store(result.skew, std::memory_order_relaxed);
+  measurement_.header.stamp = self_.stamp > target_.stamp ? self_.stamp : target_.stamp;
+  measurement_.header.frame_id = world_frame_;
+  measurement_.position.resize(static_cast<std::size_t>(axes_));
+  measurement_.velocity.resize(static_cast<std::size_t>(axes_));
+  for (int i = 0; i < axes_; ++i) {
+    measurement_.position[static_cast<std::size_t>(i)] = result.state(i);
+    measurement_.velocity[static_cast<std::size_t>(i)] = result.state(axes_ + i);
+  }
+  sink_(measurement_);
+}
+
+}  // namespace projection_collision_avoidance

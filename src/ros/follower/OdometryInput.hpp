@@ -1,0 +1,96 @@
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <mutex>
+#include <string>
+
+#include <nav_msgs/Odometry.h>
+#include <ros/ros.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_listener.h>
+
+#include "projection_collision_avoidance/RelativeMeasurement.h"
+#include "projection_collision_avoidance/ros/InputAdmission.hpp"
+#include "projection_collision_avoidance/ros/InputGuard.hpp"
+#include "projection_collision_avoidance/vehicle/RelativeStateFromOdometry.hpp"
+
+#include "follower/FollowerOptions.hpp"
+
+namespace projection_collision_avoidance {
+
+/// The follower's `odometry` input (~input odometry; doc/vehicles.md): subscribes its own
+/// `odom` and its target's `target_odom` (nav_msgs/Odometry, REP 105: pose in header.frame_id,
+/// twist in child_frame_id), judges each with an InputGuard, brings both into one world frame
+/// (~measurement_frame, else the own odometry's header.frame_id) with tf2 when a frame differs,
+/// and, at every accepted message, turns the latest pair into the relative state
+/// x_target − x_self of the controlled points (RelativeStateFromOdometry: the older sample moved
+/// to the newer stamp at constant velocity, a skew beyond ~odometry/max_skew refused; the points
+/// ~odometry/look_ahead and ~odometry/target_look_ahead ahead of each origin along its body x
+/// axis). The result goes to @p sink as a RelativeMeasurement stamped with the newer stamp, in
+/// the world frame, to be judged like any measurement. Nothing a message carries ends the node.
+class OdometryInput {
+ public:
+  using Sink = std::function<void(const RelativeMeasurement&)>;
+
+  /// @param axes of the model (2 or 3)
+  /// @throws ParameterError naming ~odometry/... (RelativeStateFromOdometry's checks)
+  OdometryInput(std::string node_name, const FollowerNodeOptions& options, int axes, Sink sink);
+
+  /// Subscribes `odom` and `target_odom` (once the sink's receiver is in place).
+  void start(ros::NodeHandle nh);
+
+  /// Odometry messages refused so far (both topics).
+  std::uint64_t rejected() const { return rejected_.load(std::memory_order_relaxed); }
+  /// Pairs of accepted messages refused by the alignment (skew, non-unit quaternion, ...).
+  std::uint64_t rejectedPairs() const { return rejected_pairs_.load(std::memory_order_relaxed); }
+  /// The world frame and the world position (m) of the own controlled point at the latest own
+  /// odometry; false before one.
+  bool controlledPoint(std::string* frame, Eigen::Vector3d* point);
+  /// The latest |t_target − t_self| of an aligned pair (s); NaN before one.
+  double skew() const { return skew_.load(std::memory_order_relaxed); }
+
+ private:
+  /// One agent's side: its guard and latest accepted sample (world frame).
+  struct Side {
+    InputGuard guard;
+    ClockWatch clock;
+    OdometrySample sample;
+    ros::Time stamp;
+    bool have = false;
+  };
+
+  void onOdometry(Side* side, const nav_msgs::Odometry::ConstPtr& msg);
+  /// @p msg's sample in the world frame; false with the reason in @p why (a tf lookup failed).
+  bool toWorld(const nav_msgs::Odometry& msg, OdometrySample* sample, std::string* why);
+  /// The relative state of the latest pair to the sink (mutex_ held), or a refusal counted.
+  void combine();
+
+  std::string name_;
+  FollowerNodeOptions options_;
+  int axes_;
+  Sink sink_;
+  RelativeStateFromOdometry relative_;
+  std::string world_frame_;  ///< "" until the first own odometry names it (no ~measurement_frame)
+
+  std::mutex mutex_;  ///< the two subscriptions may call at once (nodelets)
+  Side self_;
+  Side target_;
+  std::mutex point_mutex_;  ///< the own controlled point, read by the outputs (never nested)
+  Eigen::Vector3d point_ = Eigen::Vector3d::Zero();
+  std::string world_frame_copy_;
+  bool have_point_ = false;
+  InputGuard pair_guard_;  ///< counts and logs the pairs the alignment refuses
+  RelativeMeasurement measurement_;
+  std::atomic<std::uint64_t> rejected_{0};
+  std::atomic<std::uint64_t> rejected_pairs_{0};
+  std::atomic<double> skew_;
+
+  tf2_ros::Buffer tf_buffer_;
+  std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
+  ros::Subscriber self_subscriber_;
+  ros::Subscriber target_subscriber_;
+};
+
+}  // namespace projection_collision_avoidance
