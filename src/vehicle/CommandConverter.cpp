@@ -29,8 +29,8 @@ CommandConverter::CommandConverter(const CommandConverterOptions& options)
     : options_(options),
       integrator_(integratorOptions(options)),
       look_ahead_(options.look_ahead, options.unicycle_limits) {
-  if (options.axes != 2 && options.axes != 3) {
-    throw ParameterError("vehicle.command.axes", "must be 2 or 3");
+  if (options.axes < 1 || options.axes > 3) {
+    throw ParameterError("vehicle.command.axes", "must be 1, 2 or 3");
   }
   if (options.unicycle && options.axes != 2) {
     throw ParameterError("vehicle.command.unicycle", "needs a planar (2-axis) model");

@@ -69,9 +69,9 @@ Eigen::Matrix<double, 6, 1> bodyPointState(const OdometrySample& sample, const E
 
 RelativeStateFromOdometry::RelativeStateFromOdometry(const OdometryAlignmentOptions& options)
     : options_(options) {
-  if (options.axes != 2 && options.axes != 3) {
+  if (options.axes < 1 || options.axes > 3) {
     throw ParameterError("vehicle.odometry.axes",
-                         "must be 2 or 3, got " + std::to_string(options.axes));
+                         "must be 1, 2 or 3, got " + std::to_string(options.axes));
   }
   requireNonNegative(options.max_skew, "vehicle.odometry.max_skew", "s");
   requireNonNegative(options.quaternion_tolerance, "vehicle.odometry.quaternion_tolerance", "");

@@ -89,8 +89,11 @@ TEST(Rotation, NormalisesWithinTheToleranceAndRefusesBeyond) {
 }
 
 TEST(RelativeStateFromOdometry, RefusesUnusableOptions) {
-  OdometryAlignmentOptions o = options(1);
+  OdometryAlignmentOptions o = options(0);
   EXPECT_EQ(refusedKey(o), "vehicle.odometry.axes");
+  o = options(4);
+  EXPECT_EQ(refusedKey(o), "vehicle.odometry.axes");
+  EXPECT_EQ(refusedKey(options(1)), "");
   o = options(2, -0.1);
   EXPECT_EQ(refusedKey(o), "vehicle.odometry.max_skew");
   o = options(3, kNaN);

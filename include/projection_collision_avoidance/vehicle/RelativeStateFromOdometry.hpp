@@ -32,7 +32,7 @@ enum class TwistFrame {
 
 /// Options of RelativeStateFromOdometry.
 struct OdometryAlignmentOptions {
-  int axes = 2;                        ///< 2 (x, y: ground robots) or 3 (x, y, z)
+  int axes = 2;                        ///< 1 (x: a line), 2 (x, y: ground robots) or 3 (x, y, z)
   double max_skew = 0.05;              ///< largest |t_target − t_self| aligned (s), ≥ 0
   double quaternion_tolerance = 1e-2;  ///< largest |‖q‖ − 1| normalised (dimensionless), ≥ 0
   TwistFrame twist_frame = TwistFrame::kBody;
@@ -86,10 +86,11 @@ Eigen::Matrix<double, 6, 1> bodyPointState(const OdometrySample& sample, const E
 /// aligned, beyond it refused. Samples are checked (finite, quaternions within the tolerance,
 /// then normalised) and refused with a verdict; compute() never throws and allocates nothing.
 /// Both poses must be in the same world frame (the ROS layer's tf2 lookup makes them so). In 2-D
-/// the x, y components of the world-frame position and velocity are taken (z is dropped).
+/// the x, y components of the world-frame position and velocity are taken (z is dropped), in 1-D
+/// x alone.
 class RelativeStateFromOdometry {
  public:
-  /// @throws ParameterError naming vehicle.odometry.axes (not 2 or 3), .max_skew or
+  /// @throws ParameterError naming vehicle.odometry.axes (not 1, 2 or 3), .max_skew or
   ///         .quaternion_tolerance (negative or not finite), .self_point or .target_point
   ///         (not finite)
   explicit RelativeStateFromOdometry(const OdometryAlignmentOptions& options);

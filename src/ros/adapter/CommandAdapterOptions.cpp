@@ -65,7 +65,7 @@ CommandAdapterOptions readCommandAdapterOptions(NodeOptionReader& reader) {
   CommandAdapterOptions options;
   readOutputs(reader, &options);
   CommandConverterOptions& c = options.converter;
-  c.axes = reader.integer("axes", c.axes, 2, 3);
+  c.axes = reader.integer("axes", c.axes, 1, 3);
   c.period = 1.0 / reader.number("control_rate", 1.0 / c.period, 1e-3, 1e5);
   options.command_timeout =
       reader.number("command_timeout", options.command_timeout, c.period, 3600.0);

@@ -25,10 +25,6 @@ void FollowerOutputs::publishMarkers(const FollowerCycleOutput& out) {
   const GenericDimensions::StateVector& xi = out.xi;
   const bool inside_perimeter = out.distance < out.perimeter;
   visualization_msgs::MarkerArray markers;
-  // The controlled point: the follower frame's origin, or the look-ahead point of ~input
-  // odometry (~odometry/look_ahead along the body x axis), around which the perimeter is kept.
-  const Eigen::Vector3d centre(
-      options_.input == MeasurementInput::kOdometry ? options_.odometry.look_ahead : 0.0, 0.0, 0.0);
   // Safety perimeter alpha ||d|| around it: green, red once the target is inside.
   // A flat disc on the ground plane (a sphere in 3-D), so the markers above it stay visible.
   visualization_msgs::Marker perimeter =

@@ -88,8 +88,8 @@ void OdometryInput::onOdometry(Side* side, const nav_msgs::Odometry::ConstPtr& m
               .head<3>();
       world_frame_copy_ = world_frame_;
       have_point_ = true;
+      combine();  // each own odometry makes a measurement, with the latest of the target's
     }
-    combine();
   });
   rejected_.fetch_add(side->guard.rejected() - before, std::memory_order_relaxed);
 }

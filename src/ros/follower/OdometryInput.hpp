@@ -24,7 +24,7 @@ namespace projection_collision_avoidance {
 /// `odom` and its target's `target_odom` (nav_msgs/Odometry, REP 105: pose in header.frame_id,
 /// twist in child_frame_id), judges each with an InputGuard, brings both into one world frame
 /// (~measurement_frame, else the own odometry's header.frame_id) with tf2 when a frame differs,
-/// and, at every accepted message, turns the latest pair into the relative state
+/// and, at every accepted own odometry, turns it and the target's latest into the relative state
 /// x_target − x_self of the controlled points (RelativeStateFromOdometry: the older sample moved
 /// to the newer stamp at constant velocity, a skew beyond ~odometry/max_skew refused; the points
 /// ~odometry/look_ahead and ~odometry/target_look_ahead ahead of each origin along its body x
