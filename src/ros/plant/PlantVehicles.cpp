@@ -162,10 +162,10 @@ void PlantVehicle::advance(double h, const ros::Time& stamp) {
                                      << " velocity command fresh again");
     timed_out_ = false;
   } else if (!fresh && have_command_ && !timed_out_) {
-    ROS_WARN_STREAM(setup_.node_name
-                    << ": " << setup_.agent_name << " velocity command received at "
-                    << received_.toSec() << " s is older than ~command_timeout ("
-                    << setup_.command_timeout << " s) at " << stamp.toSec() << " s: stopping");
+    ROS_WARN_STREAM(setup_.node_name << ": " << setup_.agent_name << " velocity command is "
+                                     << secondsBetween(stamp, received_)
+                                     << " s old, more than ~command_timeout ("
+                                     << setup_.command_timeout << " s): stopping");
     timed_out_ = true;
   }
   const Eigen::Vector3d command = fresh ? command_ : Eigen::Vector3d::Zero();
