@@ -68,8 +68,12 @@ VehicleOptions readVehicle(NodeOptionReader& reader, const std::string& agent, i
   }
   for (const std::string& key : reader.mapKeys(prefix)) {
     if (std::find(allowed.begin(), allowed.end(), key) == allowed.end()) {
+      std::string takes;
+      for (const std::string& name : allowed) {
+        takes += (takes.empty() ? "" : ", ") + name;
+      }
       throw ParameterError(v.key + "/" + key,
-                           "not a parameter of kind " + kind + " (or of any kind)");
+                           "not a parameter of kind " + kind + ", which takes " + takes);
     }
   }
   if (v.kind == VehicleKind::kDoubleIntegrator) {
