@@ -2,7 +2,7 @@
 
 /// @file
 /// The fixture of test_plant_vehicles: what it keeps of the plant's outputs (odometry, applied
-/// velocity commands, relative measurements, tf), waiting on them, and the measurement check.
+/// velocity commands, relative measurements), waiting on them, and the measurement check.
 
 #include <cmath>
 #include <cstdint>
@@ -19,7 +19,6 @@
 #include <gtest/gtest.h>
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
-#include <tf2_msgs/TFMessage.h>
 
 #include "projection_collision_avoidance/RelativeMeasurement.h"
 
@@ -94,7 +93,6 @@ struct AgentRecord {
   std::map<std::int64_t, OdomSample> odom;
   std::vector<AppliedSample> applied;
   std::map<std::int64_t, Eigen::VectorXd> measurements;  ///< [p; v] of x_target − x_self
-  std::map<std::int64_t, double> tf_yaw;                 ///< yaw of world -> the agent's frame
 
   /// Seconds from sample @p a to sample @p b, exact.
   static double between(const OdomSample& a, const OdomSample& b) {
@@ -165,18 +163,6 @@ class PlantVehiclesTest : public testing::RosTestFixture {
           },
           nullptr, hints));
     }
-    subscribers_.push_back(nh_.subscribe<tf2_msgs::TFMessage>(
-        "/tf", 1000, [this](const tf2_msgs::TFMessage::ConstPtr& msg) {
-          const std::lock_guard<std::mutex> lock(mutex_);
-          for (const auto& t : msg->transforms) {
-            for (int i = 0; i < 3; ++i) {
-              if (t.child_frame_id == kAgents[i] && t.header.frame_id == "world") {
-                records_[i].tf_yaw[nanoseconds(t.header.stamp)] =
-                    testing::yawOf(t.transform.rotation);
-              }
-            }
-          }
-        }));
     deadline_ = param("wall_deadline");
     tolerance_ = param("exact_tolerance");
   }

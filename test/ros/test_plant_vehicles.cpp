@@ -28,6 +28,8 @@
 #include <Eigen/Dense>
 #include <gtest/gtest.h>
 #include <ros/ros.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_listener.h>
 
 #include "plant_vehicles_fixture.h"
 
@@ -48,7 +50,6 @@ using testing::twistOf;
 TEST_F(PlantVehiclesTest, OdometryAndTfCarryTheHeadingAsRealBasesPublishIt) {
   ASSERT_TRUE(waitFor([&] { return records_[kVelocity].odom.size() > 10; }, deadline_));
   ASSERT_TRUE(waitFor([&] { return records_[kUnicycle].odom.size() > 10; }, deadline_));
-  ASSERT_TRUE(waitFor([&] { return records_[kUnicycle].tf_yaw.size() > 10; }, deadline_));
   const double headings[] = {0.0, param("velocity_heading"), param("unicycle_heading")};
   for (const int agent : {kLeader, kVelocity, kUnicycle}) {
     const AgentRecord r = record(agent);
@@ -62,11 +63,28 @@ TEST_F(PlantVehiclesTest, OdometryAndTfCarryTheHeadingAsRealBasesPublishIt) {
         ASSERT_NEAR(testing::angleBetween(s.yaw, headings[agent]), 0.0, tolerance_)
             << kAgents[agent] << " at " << s.t;
       }
-      const auto tf = r.tf_yaw.find(stamp);
-      if (tf != r.tf_yaw.end()) {
-        ASSERT_NEAR(testing::angleBetween(tf->second, s.yaw), 0.0, tolerance_);
-      }
     }
+  }
+  // tf world -> the agent's frame: the odometry's pose, the yaw included.
+  tf2_ros::Buffer buffer;
+  tf2_ros::TransformListener listener(buffer);
+  for (const int agent : {kVelocity, kUnicycle}) {
+    ASSERT_TRUE(waitFor([&] { return buffer.canTransform("world", kAgents[agent], ros::Time(0)); },
+                        deadline_));
+    const double after = record(agent).lastTime();  // a sample the listener was there for
+    ASSERT_TRUE(waitForOdom(agent, after + 0.05));
+    const OdomSample s = record(agent).odom.rbegin()->second;
+    ros::Time stamp;
+    stamp.fromNSec(static_cast<std::uint64_t>(s.ns));
+    ASSERT_TRUE(
+        waitFor([&] { return buffer.canTransform("world", kAgents[agent], stamp); }, deadline_))
+        << kAgents[agent];
+    const geometry_msgs::TransformStamped t =
+        buffer.lookupTransform("world", kAgents[agent], stamp);
+    const auto& x = t.transform.translation;
+    EXPECT_LE((Eigen::Vector3d(x.x, x.y, x.z) - s.position).norm(), tolerance_);
+    EXPECT_NEAR(testing::angleBetween(testing::yawOf(t.transform.rotation), s.yaw), 0.0,
+                tolerance_);
   }
 }
 
