@@ -118,18 +118,21 @@ struct AgentRecord {
 constexpr int kLeader = 0;
 constexpr int kVelocity = 1;
 constexpr int kUnicycle = 2;
-const char* const kAgents[] = {"leader", "follower_1", "follower_2"};
+constexpr int kWorldVelocity = 3;  ///< a velocity vehicle without lag taking world-frame Twists
+constexpr int kAgentCount = 4;
+const char* const kAgents[] = {"leader", "follower_1", "follower_2", "follower_3"};
 
 inline std::int64_t nanoseconds(const ros::Time& t) {
   return static_cast<std::int64_t>(t.toNSec());
 }
 
-/// Records the plant's outputs for the leader, follower_1 (velocity) and follower_2 (unicycle).
+/// Records the plant's outputs for the leader, follower_1 (velocity), follower_2 (unicycle) and
+/// follower_3 (velocity, world-frame Twists).
 class PlantVehiclesTest : public testing::RosTestFixture {
  protected:
   PlantVehiclesTest() {
     const ros::TransportHints hints = ros::TransportHints().tcpNoDelay();
-    for (int i = 0; i < 3; ++i) {
+    for (int i = 0; i < kAgentCount; ++i) {
       const std::string agent = std::string("/") + kAgents[i];
       subscribers_.push_back(nh_.subscribe<nav_msgs::Odometry>(
           agent + "/odom", 1000,
@@ -241,7 +244,7 @@ class PlantVehiclesTest : public testing::RosTestFixture {
 
   double deadline_ = 0.0;
   double tolerance_ = 0.0;
-  AgentRecord records_[3];
+  AgentRecord records_[kAgentCount];
   std::vector<ros::Subscriber> subscribers_;
 };
 

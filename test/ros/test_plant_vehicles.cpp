@@ -1,9 +1,11 @@
 /// rostest: the plant's vehicle kinds (test/ros/plant_vehicles.test): follower_1 a velocity-
 /// controlled vehicle (lag τ_v, fixed heading ψ, Twists in its body frame), follower_2 a unicycle
-/// (lag τ_u, initial heading θ_0), on ROS time. Parameters of the test node (SI units):
+/// (lag τ_u, initial heading θ_0), follower_3 a velocity-controlled vehicle without lag taking
+/// world-frame Twists, on ROS time. Parameters of the test node (SI units):
 ///   ~rate, ~command_timeout        the plant's
 ///   ~command_rate                  Hz of the cmd_vel streams sent
-///   ~velocity_lag, ~velocity_heading, ~unicycle_lag, ~unicycle_heading  the plant's ~vehicles
+///   ~velocity_lag, ~velocity_heading, ~unicycle_lag, ~unicycle_heading,
+///   ~world_velocity_heading        the plant's ~vehicles
 ///   ~velocity_command              m/s along the body x axis of follower_1
 ///   ~lag_fraction, ~lag_fraction_tolerance  (v(τ) − v0) / (v_cmd − v0) expected: 1 − e^(−1)
 ///   ~rest_speed                    m/s below which follower_1 counts as at rest
@@ -43,6 +45,7 @@ using testing::kAgents;
 using testing::kLeader;
 using testing::kUnicycle;
 using testing::kVelocity;
+using testing::kWorldVelocity;
 using testing::OdomSample;
 using testing::PlantVehiclesTest;
 using testing::twistOf;
@@ -50,8 +53,9 @@ using testing::twistOf;
 TEST_F(PlantVehiclesTest, OdometryAndTfCarryTheHeadingAsRealBasesPublishIt) {
   ASSERT_TRUE(waitFor([&] { return records_[kVelocity].odom.size() > 10; }, deadline_));
   ASSERT_TRUE(waitFor([&] { return records_[kUnicycle].odom.size() > 10; }, deadline_));
-  const double headings[] = {0.0, param("velocity_heading"), param("unicycle_heading")};
-  for (const int agent : {kLeader, kVelocity, kUnicycle}) {
+  const double headings[] = {0.0, param("velocity_heading"), param("unicycle_heading"),
+                             param("world_velocity_heading")};
+  for (const int agent : {kLeader, kVelocity, kUnicycle, kWorldVelocity}) {
     const AgentRecord r = record(agent);
     for (const auto& [stamp, s] : r.odom) {
       ASSERT_EQ(s.frame, "world");
@@ -125,6 +129,33 @@ TEST_F(PlantVehiclesTest, VelocityVehicleFollowsItsBodyFrameCommandWithItsLag) {
   const Eigen::Vector3d moved = settled.position - first.position;
   EXPECT_NEAR(testing::angleBetween(std::atan2(moved.y(), moved.x()), psi), 0.0, 1e-3);
   EXPECT_GT(checkMeasurements(kVelocity), 100);
+}
+
+TEST_F(PlantVehiclesTest, WorldFrameTwistsAreTakenAsTheyAreWithoutLag) {
+  const double psi = param("world_velocity_heading");
+  const Eigen::Vector3d command(0.3, -0.4, 0.0);
+  const double quiet = waitForStop(kWorldVelocity);
+  const auto commands = stream(kWorldVelocity, false);
+  commands->set(twistOf(command.x(), command.y(), 7.0, 0.0, 0.0, 1.0));  // z: beyond the 2 axes
+  const double start = firstApplied(kWorldVelocity, quiet, false);
+  ASSERT_TRUE(waitForOdom(kWorldVelocity, start + 0.5));
+  const AgentRecord r = record(kWorldVelocity);
+  for (const AppliedSample& a : r.applied) {
+    if (a.t >= start && a.t <= start + 0.5) {
+      ASSERT_EQ(a.frame, "world");
+      ASSERT_EQ(a.linear, command);
+    }
+  }
+  for (const auto& [stamp, s] : r.odom) {  // τ = 0: the command's velocity from the next tick
+    if (s.t > start + 0.005 && s.t <= start + 0.5) {
+      ASSERT_LE((s.worldVelocity() - command).norm(), tolerance_) << s.t;
+      ASSERT_NEAR(s.linear.x(), std::cos(psi) * command.x() + std::sin(psi) * command.y(),
+                  tolerance_);
+      ASSERT_NEAR(s.linear.y(), -std::sin(psi) * command.x() + std::cos(psi) * command.y(),
+                  tolerance_);
+    }
+  }
+  EXPECT_GT(checkMeasurements(kWorldVelocity), 10);
 }
 
 TEST_F(PlantVehiclesTest, UnicycleDrivesACircleOfRadiusVOverOmega) {
