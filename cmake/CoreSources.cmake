@@ -17,7 +17,7 @@ set(PCA_CORE_SOURCES
 
 # projection_collision_avoidance_sim: simulation and experiment tooling around the controller
 # (the plant, the sampled and continuous loops, sweeps, the measurement channel and the link of
-# shared information); Eigen and std only.
+# shared information, the simulated velocity-controlled and unicycle vehicles); Eigen and std only.
 set(PCA_SIM_SOURCES
   src/sim/AgentIntegrator.cpp
   src/sim/ContinuousSimulator.cpp
@@ -30,6 +30,7 @@ set(PCA_SIM_SOURCES
   src/sim/SignalProfile.cpp
   src/sim/SimulationCsvWriter.cpp
   src/sim/StringStability.cpp
+  src/sim/VehicleModels.cpp
 )
 
 # projection_collision_avoidance_scenario: scenario files (libyaml parses them into yaml-cpp

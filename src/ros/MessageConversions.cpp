@@ -117,6 +117,22 @@ nav_msgs::Odometry toOdometryMsg(const Eigen::Ref<const Eigen::VectorXd>& state,
   return msg;
 }
 
+nav_msgs::Odometry toBodyOdometryMsg(const Eigen::Vector3d& position, double yaw,
+                                     const Eigen::Vector3d& body_linear,
+                                     const Eigen::Vector3d& body_angular, const ros::Time& stamp,
+                                     const std::string& frame, const std::string& child_frame) {
+  nav_msgs::Odometry msg;
+  msg.header.stamp = stamp;
+  msg.header.frame_id = frame;
+  msg.child_frame_id = child_frame;
+  msg.pose.pose.position = tf2::toMsg(position);
+  msg.pose.pose.orientation =
+      tf2::toMsg(Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ())));
+  tf2::toMsg(body_linear, msg.twist.twist.linear);
+  tf2::toMsg(body_angular, msg.twist.twist.angular);
+  return msg;
+}
+
 bool stateFromOdometryMsg(const nav_msgs::Odometry& msg, int axes, Eigen::VectorXd* state) {
   Eigen::Vector3d position;
   Eigen::Vector3d velocity;
@@ -146,6 +162,19 @@ geometry_msgs::TransformStamped toTransformMsg(const Eigen::Ref<const Eigen::Vec
                                                const std::string& child) {
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   pose.translation() = toVector3(position);
+  geometry_msgs::TransformStamped msg = tf2::eigenToTransform(pose);
+  msg.header.stamp = stamp;
+  msg.header.frame_id = parent;
+  msg.child_frame_id = child;
+  return msg;
+}
+
+geometry_msgs::TransformStamped toTransformMsg(const Eigen::Vector3d& position, double yaw,
+                                               const ros::Time& stamp, const std::string& parent,
+                                               const std::string& child) {
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.translation() = position;
+  pose.linear() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   geometry_msgs::TransformStamped msg = tf2::eigenToTransform(pose);
   msg.header.stamp = stamp;
   msg.header.frame_id = parent;

@@ -248,6 +248,21 @@ std::string NodeOptionReader::text(const std::string& key, const std::string& fa
   return result;
 }
 
+std::vector<std::string> NodeOptionReader::mapKeys(const std::string& key) {
+  XmlRpc::XmlRpcValue value;
+  std::vector<std::string> keys;
+  if (!lookup(key, &value)) {
+    return keys;
+  }
+  if (value.getType() != XmlRpc::XmlRpcValue::TypeStruct) {
+    throw ParameterError("~" + key, "must be a map, got " + typeName(value));
+  }
+  for (const auto& entry : value) {
+    keys.push_back(entry.first);
+  }
+  return keys;  // std::map order: sorted
+}
+
 void NodeOptionReader::echo(const std::string& node_name) const {
   for (const std::string& line : lines_) {
     ROS_INFO_STREAM(node_name << ": " << line);

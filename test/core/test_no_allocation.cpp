@@ -1,5 +1,6 @@
 /// A control step allocates no memory (counted by test/common/AllocationCounter.cpp).
 
+#include <cmath>
 #include <cstddef>
 #include <limits>
 #include <vector>
@@ -14,6 +15,7 @@
 #include "projection_collision_avoidance/sim/ContinuousDynamics.hpp"
 #include "projection_collision_avoidance/sim/SampledSimulator.hpp"
 #include "projection_collision_avoidance/sim/ScenarioEmbedding.hpp"
+#include "projection_collision_avoidance/sim/VehicleModels.hpp"
 
 #include "AllocationCounter.hpp"
 #include "TestScenarios.hpp"
@@ -199,6 +201,28 @@ TEST(NoAllocation, DisturbedAgentStepsAwayFromPulseEdges) {
   }
   EXPECT_EQ(testing::allocationCount() - before, 0);
   EXPECT_TRUE(leader.state().allFinite());
+}
+
+/// The simulated vehicles of the plant take commands and step without the heap.
+TEST(NoAllocation, VehicleModelSteps) {
+  VelocityLagParameters lag;
+  lag.velocity_lag = 0.2;
+  lag.max_speed = 1.0;
+  VelocityLagVehicle velocity(3, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), lag);
+  UnicycleParameters unicycle_parameters;
+  unicycle_parameters.velocity_lag = 0.1;
+  unicycle_parameters.max_yaw_rate = 1.0;
+  UnicycleVehicle unicycle(UnicycleState{}, unicycle_parameters);
+  const long before = testing::allocationCount();
+  for (int k = 0; k < 1000; ++k) {
+    velocity.setCommand(Eigen::Vector3d(0.01 * k, -1.0, 0.5));
+    velocity.advance(0.01);
+    unicycle.setCommand(1.0, 0.01 * (k % 300));
+    unicycle.advance(k % 2 == 0 ? 0.01 : 0.5);
+  }
+  EXPECT_EQ(testing::allocationCount() - before, 0);
+  EXPECT_TRUE(velocity.position().allFinite());
+  EXPECT_TRUE(std::isfinite(unicycle.state().x));
 }
 
 /// The sampled closed loop allocates while it sets up and nothing per tick: a run twice as long

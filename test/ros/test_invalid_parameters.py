@@ -541,6 +541,12 @@ def opt(name, node, key, value):
     return case(name, "~" + key, options={key: value}, nodes=(node,))
 
 
+def vehicle(name, key, entry, agent="follower", change=None):
+    """A plant whose ~vehicles/<agent> is @p entry, refused naming ~vehicles/<agent>[/key]."""
+    return case(name, f"~vehicles/{agent}" + (f"/{key}" if key else ""), change,
+                options={"vehicles": {agent: entry}}, nodes=(PLANT,))
+
+
 def on_thread(name, key, value):
     """A follower option spoiled on a follower with ~control_loop thread."""
     return case(name, "~" + key, options={"control_loop": "thread", key: value}, nodes=(FOLLOWER,))
@@ -639,6 +645,28 @@ NODE_OPTIONS = [
     opt("real_time_factor inf", PLANT, "real_time_factor", INF),
     opt("duration < 0", PLANT, "duration", -1.0),
     opt("duration NaN", PLANT, "duration", NAN),
+    # plant_node ~vehicles (Run 2 is 1-D with one follower: agents leader and follower)
+    opt("vehicles a list", PLANT, "vehicles", [1, 2]),
+    vehicle("vehicles entry a string", "", "velocity"),
+    vehicle("vehicles unknown agent", "", {"kind": "velocity"}, agent="follower_1"),
+    vehicle("vehicle kind unknown", "kind", {"kind": "tank"}),
+    vehicle("vehicle kind a number", "kind", {"kind": 2}),
+    vehicle("unicycle on one axis", "kind", {"kind": "unicycle"}),
+    vehicle("vehicle key unknown", "wheel_base", {"kind": "velocity", "wheel_base": 0.3}),
+    vehicle("velocity_lag on a double integrator", "velocity_lag", {"velocity_lag": 0.1},
+            agent="leader"),
+    vehicle("max_yaw_rate on a velocity vehicle", "max_yaw_rate",
+            {"kind": "velocity", "max_yaw_rate": 1.0}),
+    vehicle("twist_frame on a unicycle", "twist_frame",
+            {"kind": "unicycle", "twist_frame": "world"}, change=two_axes),
+    vehicle("velocity_lag < 0", "velocity_lag", {"kind": "velocity", "velocity_lag": -0.1}),
+    vehicle("velocity_lag NaN", "velocity_lag", {"kind": "velocity", "velocity_lag": NAN}),
+    vehicle("max_speed = 0", "max_speed", {"kind": "velocity", "max_speed": 0.0}),
+    vehicle("max_speed a string", "max_speed", {"kind": "velocity", "max_speed": "fast"}),
+    vehicle("heading inf", "heading", {"kind": "velocity", "heading": INF}),
+    vehicle("twist_frame unknown", "twist_frame", {"kind": "velocity", "twist_frame": "base"}),
+    vehicle("max_yaw_rate < 0", "max_yaw_rate", {"kind": "unicycle", "max_yaw_rate": -1.0},
+            change=two_axes),
     # leader_node
     opt("rate = 0", LEADER, "rate", 0.0),
     opt("rate < 0", LEADER, "rate", -5),

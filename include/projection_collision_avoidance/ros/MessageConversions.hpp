@@ -63,6 +63,14 @@ nav_msgs::Odometry toOdometryMsg(const Eigen::Ref<const Eigen::VectorXd>& state,
                                  const ros::Time& stamp, const std::string& frame,
                                  const std::string& child_frame);
 
+/// Odometry as a real base publishes it (REP 105): pose (@p position, m, and the yaw quaternion
+/// of @p yaw, rad) in @p frame, twist (@p body_linear, m/s, @p body_angular, rad/s) in the body
+/// frame @p child_frame; covariances 0.
+nav_msgs::Odometry toBodyOdometryMsg(const Eigen::Vector3d& position, double yaw,
+                                     const Eigen::Vector3d& body_linear,
+                                     const Eigen::Vector3d& body_angular, const ros::Time& stamp,
+                                     const std::string& frame, const std::string& child_frame);
+
 /// The state [p; v] (2 axes entries) of an Odometry; false if non-finite.
 bool stateFromOdometryMsg(const nav_msgs::Odometry& msg, int axes, Eigen::VectorXd* state);
 
@@ -87,6 +95,11 @@ visualization_msgs::Marker toMarker(const std::string& frame, const ros::Time& s
 
 /// The transform of a frame at @p position (1-3 entries) with identity rotation.
 geometry_msgs::TransformStamped toTransformMsg(const Eigen::Ref<const Eigen::VectorXd>& position,
+                                               const ros::Time& stamp, const std::string& parent,
+                                               const std::string& child);
+
+/// The transform of a frame at @p position (m) turned by @p yaw (rad) about z.
+geometry_msgs::TransformStamped toTransformMsg(const Eigen::Vector3d& position, double yaw,
                                                const ros::Time& stamp, const std::string& parent,
                                                const std::string& child);
 

@@ -63,6 +63,9 @@ class NodeOptionReader {
   int integer(const std::string& key, int fallback, int min, int max);
   bool boolean(const std::string& key, bool fallback);
   std::string text(const std::string& key, const std::string& fallback);
+  /// The keys of the map parameter @p key, sorted; none when it is absent.
+  /// @throws ParameterError ("~<key>") when it is present but not a map
+  std::vector<std::string> mapKeys(const std::string& key);
 
   /// Logs every option read, once, as "name: key = value" lines.
   void echo(const std::string& node_name) const;

@@ -1,7 +1,9 @@
 #include "plant/PlantOptions.hpp"
 
+#include <algorithm>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include "projection_collision_avoidance/core/ParameterError.hpp"
 
@@ -17,7 +19,110 @@ std::string frameParameter(NodeOptionReader& reader, const std::string& key,
   return frame;
 }
 
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kTwoPi = 6.283185307179586476925286766559;
+
+/// The agents' names of @p scenario: "leader", then "follower" or "follower_1" .. "follower_N".
+std::vector<std::string> agentNames(const Scenario& scenario) {
+  std::vector<std::string> names{"leader"};
+  if (!scenario.formation.configured) {
+    names.emplace_back("follower");
+  }
+  for (int i = 1; scenario.formation.configured && i <= scenario.formation.followers; ++i) {
+    names.push_back("follower_" + std::to_string(i));
+  }
+  return names;
+}
+
+/// A limit in (0, inf]; absent: none (inf).
+double limitParameter(NodeOptionReader& reader, const std::string& key) {
+  const double limit = reader.number(key, kInf, 0.0, kInf);
+  if (!(limit > 0.0)) {
+    throw ParameterError("~" + key, "must be > 0 (leave it out for no limit), got 0");
+  }
+  return limit;
+}
+
+/// ~vehicles/<agent>: its kind and the parameters of that kind (others refused by name).
+VehicleOptions readVehicle(NodeOptionReader& reader, const std::string& agent, int axes) {
+  const std::string prefix = "vehicles/" + agent;
+  VehicleOptions v;
+  v.key = "~" + prefix;
+  const std::string kind = reader.text(prefix + "/kind", toString(v.kind));
+  if (kind == "velocity") {
+    v.kind = VehicleKind::kVelocity;
+  } else if (kind == "unicycle") {
+    v.kind = VehicleKind::kUnicycle;
+  } else if (kind != "double_integrator") {
+    throw ParameterError(v.key + "/kind",
+                         "must be double_integrator, velocity or unicycle, got '" + kind + "'");
+  }
+  if (v.kind == VehicleKind::kUnicycle && axes < 2) {
+    throw ParameterError(v.key + "/kind",
+                         "unicycle needs a model of 2 or 3 axes, got " + std::to_string(axes));
+  }
+  std::vector<std::string> allowed{"kind"};
+  if (v.kind != VehicleKind::kDoubleIntegrator) {
+    allowed.insert(allowed.end(), {"velocity_lag", "max_speed", "heading"});
+    allowed.emplace_back(v.kind == VehicleKind::kUnicycle ? "max_yaw_rate" : "twist_frame");
+  }
+  for (const std::string& key : reader.mapKeys(prefix)) {
+    if (std::find(allowed.begin(), allowed.end(), key) == allowed.end()) {
+      std::string takes;
+      for (const std::string& name : allowed) {
+        takes += (takes.empty() ? "" : ", ") + name;
+      }
+      throw ParameterError(v.key + "/" + key,
+                           "not a parameter of kind " + kind + ", which takes " + takes);
+    }
+  }
+  if (v.kind == VehicleKind::kDoubleIntegrator) {
+    return v;
+  }
+  v.velocity_lag = reader.number(prefix + "/velocity_lag", 0.0, 0.0, 1000.0);
+  v.max_speed = limitParameter(reader, prefix + "/max_speed");
+  v.heading = reader.number(prefix + "/heading", 0.0, -kTwoPi, kTwoPi);
+  if (v.kind == VehicleKind::kUnicycle) {
+    v.max_yaw_rate = limitParameter(reader, prefix + "/max_yaw_rate");
+  } else {
+    const std::string frame = reader.text(prefix + "/twist_frame", "body");
+    if (frame != "body" && frame != "world") {
+      throw ParameterError(v.key + "/twist_frame", "must be body or world, got '" + frame + "'");
+    }
+    v.twist_in_body = frame == "body";
+  }
+  return v;
+}
+
+/// ~vehicles: a map by agent name; each name one of the scenario's agents.
+std::map<std::string, VehicleOptions> readVehicles(NodeOptionReader& reader,
+                                                   const Scenario& scenario) {
+  const std::vector<std::string> names = agentNames(scenario);
+  std::map<std::string, VehicleOptions> vehicles;
+  for (const std::string& agent : reader.mapKeys("vehicles")) {
+    if (std::find(names.begin(), names.end(), agent) == names.end()) {
+      throw ParameterError("~vehicles/" + agent,
+                           "no such agent: the scenario's are leader and " +
+                               (names.size() == 2 ? names[1] : names[1] + " .. " + names.back()));
+    }
+    vehicles[agent] = readVehicle(reader, agent, scenario.controller.model.double_integrator_axes);
+  }
+  return vehicles;
+}
+
 }  // namespace
+
+const char* toString(VehicleKind kind) {
+  switch (kind) {
+    case VehicleKind::kVelocity:
+      return "velocity";
+    case VehicleKind::kUnicycle:
+      return "unicycle";
+    case VehicleKind::kDoubleIntegrator:
+      break;
+  }
+  return "double_integrator";
+}
 
 PlantNodeOptions readPlantOptions(NodeOptionReader& reader, const Scenario& scenario) {
   PlantNodeOptions o;
@@ -64,6 +169,7 @@ PlantNodeOptions readPlantOptions(NodeOptionReader& reader, const Scenario& scen
                          "is true but ~publish_clock is false: only a plant that drives "
                          "simulated time can wait for the commands");
   }
+  o.vehicles = readVehicles(reader, scenario);
   return o;
 }
 

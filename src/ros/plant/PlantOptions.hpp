@@ -1,5 +1,7 @@
 #pragma once
 
+#include <limits>
+#include <map>
 #include <string>
 
 #include "projection_collision_avoidance/ros/RosParameters.hpp"
@@ -7,6 +9,27 @@
 #include "projection_collision_avoidance/sim/Scenario.hpp"
 
 namespace projection_collision_avoidance {
+
+/// How the plant simulates an agent (~vehicles/<agent>/kind).
+enum class VehicleKind {
+  kDoubleIntegrator,  ///< "double_integrator": AccelStamped on <agent>/command (the default)
+  kVelocity,          ///< "velocity": VelocityLagVehicle, Twist on <agent>/cmd_vel
+  kUnicycle,          ///< "unicycle": UnicycleVehicle, Twist on <agent>/cmd_vel
+};
+
+/// "double_integrator", "velocity", "unicycle".
+const char* toString(VehicleKind kind);
+
+/// One agent's entry of ~vehicles (doc/ros_interface.md).
+struct VehicleOptions {
+  VehicleKind kind = VehicleKind::kDoubleIntegrator;
+  std::string key;            ///< "~vehicles/<agent>": its parameters' prefix in errors
+  double velocity_lag = 0.0;  ///< τ (s) of the velocity (and the unicycle's yaw rate)
+  double max_speed = std::numeric_limits<double>::infinity();     ///< m/s; inf: none
+  double max_yaw_rate = std::numeric_limits<double>::infinity();  ///< rad/s (unicycle); inf: none
+  double heading = 0.0;       ///< rad: the unicycle's initial θ, the velocity kind's fixed yaw
+  bool twist_in_body = true;  ///< velocity: cmd_vel's linear part in the body frame, else world
+};
 
 /// The plant node's own options (besides the scenario), read once from its private namespace.
 struct PlantNodeOptions {
@@ -27,6 +50,9 @@ struct PlantNodeOptions {
   /// [t_k, t_k+1] with those commands: the sampled loop of cf_sim, however loaded the machine.
   bool lockstep = false;
   double lockstep_timeout = 1.0;  ///< wall s a tick waits for the commands in lockstep
+  /// ~vehicles by agent name ("leader", "follower", "follower_<i>"); an agent not listed is a
+  /// double integrator.
+  std::map<std::string, VehicleOptions> vehicles;
 };
 
 /// The plant node's options from its private namespace, each validated (the message names the

@@ -26,16 +26,6 @@ constexpr double kMarkerRate = 20.0;
 /// Wall seconds between the last tick's messages and the shutdown, to let them out.
 constexpr double kShutdownDelay = 0.25;
 
-visualization_msgs::Marker labelMarker(const std::string& frame, const ros::Time& stamp, int id,
-                                       const std::string& text, double height) {
-  visualization_msgs::Marker marker =
-      toMarker(frame, stamp, "labels", id, visualization_msgs::Marker::TEXT_VIEW_FACING,
-               Eigen::Vector3d(0.0, 0.0, height), 0.3, MarkerColor{});
-  marker.scale.x = marker.scale.y = 0.0;
-  marker.text = text;
-  return marker;
-}
-
 }  // namespace
 
 PlantWorld::Agent::Agent(const std::string& agent_name, const std::string& tf_frame,
@@ -79,24 +69,17 @@ PlantWorld::PlantWorld(ros::NodeHandle nh, ros::NodeHandle private_nh)
                  member.target,
                  {}});
   }
-  leader_.odom_publisher = nh_.advertise<nav_msgs::Odometry>("leader/odom", 10);
-  leader_.applied_command_publisher =
-      nh_.advertise<geometry_msgs::AccelStamped>("leader/applied_command", 10);
-  leader_.command_subscriber = nh_.subscribe<geometry_msgs::AccelStamped>(
-      "leader/command", 10,
-      [this](const geometry_msgs::AccelStamped::ConstPtr& msg) { onCommand(&leader_, msg); },
-      ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
+  attachVehicle(&leader_);
+  if (leader_.vehicle &&
+      (!scenario_.disturbance.pulses.empty() || scenario_.disturbance.hasSinusoids())) {
+    ROS_WARN_STREAM(name_ << ": the leader is a vehicle kind: leader.disturbance does not act");
+  }
+  connectAgent(&leader_);
   for (Follower& follower : followers_) {
-    Agent* agent = &follower.agent;
-    agent->odom_publisher = nh_.advertise<nav_msgs::Odometry>(agent->name + "/odom", 10);
-    agent->applied_command_publisher =
-        nh_.advertise<geometry_msgs::AccelStamped>(agent->name + "/applied_command", 10);
+    attachVehicle(&follower.agent);
+    connectAgent(&follower.agent);
     follower.measurement_publisher =
-        nh_.advertise<RelativeMeasurement>(agent->name + "/relative_measurement", 10);
-    agent->command_subscriber = nh_.subscribe<geometry_msgs::AccelStamped>(
-        agent->name + "/command", 10,
-        [this, agent](const geometry_msgs::AccelStamped::ConstPtr& msg) { onCommand(agent, msg); },
-        ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
+        nh_.advertise<RelativeMeasurement>(follower.agent.name + "/relative_measurement", 10);
   }
   marker_publisher_ = nh_.advertise<visualization_msgs::MarkerArray>("agent_markers", 2);
   ticks_per_marker_ = std::max(1L, static_cast<long>(std::ceil(options_.rate / kMarkerRate)));
@@ -119,9 +102,15 @@ PlantWorld::PlantWorld(ros::NodeHandle nh, ros::NodeHandle private_nh)
   hooks.stop = [this](const std::string& why) { stop(why); };
   hooks.jump = [this](double /*jump*/) {
     // A restarted /clock: commands of the new timeline are judged afresh.
-    leader_.command_guard.restartTimeline();
+    const auto restart = [](Agent& agent) {
+      agent.command_guard.restartTimeline();
+      if (agent.vehicle) {
+        agent.vehicle->restartTimeline();
+      }
+    };
+    restart(leader_);
     for (Follower& follower : followers_) {
-      follower.agent.command_guard.restartTimeline();
+      restart(follower.agent);
     }
   };
   hooks.listening = [this] {
@@ -151,12 +140,40 @@ PlantWorld::PlantWorld(ros::NodeHandle nh, ros::NodeHandle private_nh)
   ROS_INFO_STREAM(summary.str());
 }
 
+void PlantWorld::attachVehicle(Agent* agent) {
+  const auto found = options_.vehicles.find(agent->name);
+  if (found == options_.vehicles.end() || found->second.kind == VehicleKind::kDoubleIntegrator) {
+    return;
+  }
+  agent->vehicle = std::make_unique<PlantVehicle>(
+      found->second,
+      PlantVehicle::Setup{name_, agent->name, agent->frame, options_.world_frame, axes_,
+                          options_.command_timeout},
+      agent->integrator.state());
+  ROS_INFO_STREAM(name_ << ": " << agent->name << " is a " << toString(found->second.kind)
+                        << " vehicle: commands on " << agent->name << "/cmd_vel");
+}
+
+void PlantWorld::connectAgent(Agent* agent) {
+  if (agent->vehicle) {
+    agent->vehicle->connect(nh_, &mutex_, [this] { return plantNow(); });
+    return;
+  }
+  agent->odom_publisher = nh_.advertise<nav_msgs::Odometry>(agent->name + "/odom", 10);
+  agent->applied_command_publisher =
+      nh_.advertise<geometry_msgs::AccelStamped>(agent->name + "/applied_command", 10);
+  agent->command_subscriber = nh_.subscribe<geometry_msgs::AccelStamped>(
+      agent->name + "/command", 10,
+      [this, agent](const geometry_msgs::AccelStamped::ConstPtr& msg) { onCommand(agent, msg); },
+      ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
+}
+
 void PlantWorld::onCommand(Agent* agent, const geometry_msgs::AccelStamped::ConstPtr& msg) {
   const std::lock_guard<std::mutex> lock(mutex_);
   // A command stamped ahead of the plant's time by more than ~command_timeout would never time
   // out: its sender's clock is not the plant's (a wall-time stamp under simulated time, say).
   admitGuarded(agent->command_guard, name_, [&] {
-    const ros::Time now = clock_ ? clock_->now() : ros::Time::now();
+    const ros::Time now = plantNow();
     if (!checkHeader(agent->command_guard, msg->header, now)) {
       return;
     }
@@ -181,20 +198,11 @@ bool PlantWorld::tick(long k) {
   const ros::Time stamp = clock_->stampOf(k);
 
   // Sample: odometry, tf, relative measurements.
-  const Eigen::VectorXd leader_state = leader_.integrator.state();
   std::vector<geometry_msgs::TransformStamped> transforms;
   transforms.reserve(1 + followers_.size());
-  leader_.odom_publisher.publish(
-      toOdometryMsg(leader_state, stamp, options_.world_frame, leader_.frame));
-  transforms.push_back(
-      toTransformMsg(leader_state.head(axes_), stamp, options_.world_frame, leader_.frame));
+  sampleAgent(&leader_, stamp, &transforms);
   for (std::size_t i = 0; i < followers_.size(); ++i) {
-    Follower& follower = followers_[i];
-    const Eigen::VectorXd state = follower.agent.integrator.state();
-    follower.agent.odom_publisher.publish(
-        toOdometryMsg(state, stamp, options_.world_frame, follower.agent.frame));
-    transforms.push_back(
-        toTransformMsg(state.head(axes_), stamp, options_.world_frame, follower.agent.frame));
+    sampleAgent(&followers_[i].agent, stamp, &transforms);
     publishMeasurement(static_cast<int>(i), k);
   }
   tf_broadcaster_.sendTransform(transforms);
@@ -219,6 +227,18 @@ bool PlantWorld::tick(long k) {
   return true;
 }
 
+void PlantWorld::sampleAgent(Agent* agent, const ros::Time& stamp,
+                             std::vector<geometry_msgs::TransformStamped>* transforms) {
+  if (agent->vehicle) {
+    agent->vehicle->publishSample(stamp, transforms);
+    return;
+  }
+  const Eigen::VectorXd state = agent->integrator.state();
+  agent->odom_publisher.publish(toOdometryMsg(state, stamp, options_.world_frame, agent->frame));
+  transforms->push_back(
+      toTransformMsg(state.head(axes_), stamp, options_.world_frame, agent->frame));
+}
+
 void PlantWorld::advanceAll(long k) {
   const double t = static_cast<double>(k) / options_.rate;
   const ros::Time stamp = clock_->stampOf(k);
@@ -231,7 +251,8 @@ void PlantWorld::advanceAll(long k) {
 bool PlantWorld::commandsAnswer(long k) const {
   const std::int64_t due = nanosecondsOf(clock_->stampOf(k));
   const auto answered = [due](const Agent& agent) {
-    return !agent.command_guard.haveAccepted() || agent.command_guard.lastStamp() >= due;
+    return agent.vehicle || !agent.command_guard.haveAccepted() ||
+           agent.command_guard.lastStamp() >= due;
   };
   return answered(leader_) &&
          std::all_of(followers_.begin(), followers_.end(),
@@ -239,6 +260,10 @@ bool PlantWorld::commandsAnswer(long k) const {
 }
 
 void PlantWorld::advanceAgent(Agent* agent, double t, const ros::Time& stamp) {
+  if (agent->vehicle) {
+    agent->vehicle->advance(1.0 / options_.rate, stamp);
+    return;
+  }
   const GenericDimensions::InputVector command = commandAt(agent, stamp);
   agent->applied_command_publisher.publish(toAccelMsg(command, stamp, agent->frame));
   agent->integrator.advance(t, command);
@@ -246,8 +271,7 @@ void PlantWorld::advanceAgent(Agent* agent, double t, const ros::Time& stamp) {
 
 void PlantWorld::publishMeasurement(int index, long k) {
   Follower& follower = followers_[static_cast<std::size_t>(index)];
-  const Eigen::VectorXd relative =
-      targetOf(follower).integrator.state() - follower.agent.integrator.state();
+  const Eigen::VectorXd relative = targetOf(follower).state() - follower.agent.state();
   const double t = static_cast<double>(k) / options_.rate;
   switch (channels_->sample(index, k, relative)) {
     case OutageChange::kBegan:
@@ -273,30 +297,6 @@ void PlantWorld::publishMeasurement(int index, long k) {
 const PlantWorld::Agent& PlantWorld::targetOf(const Follower& follower) const {
   return follower.target == 0 ? leader_
                               : followers_[static_cast<std::size_t>(follower.target - 1)].agent;
-}
-
-void PlantWorld::publishMarkers(const ros::Time& stamp) {
-  using visualization_msgs::Marker;
-  visualization_msgs::MarkerArray markers;
-  markers.markers.push_back(toMarker(leader_.frame, stamp, "agents", 0, Marker::CUBE,
-                                     Eigen::Vector3d::Zero(), 0.6, {0.1F, 0.3F, 1.0F, 1.0F}));
-  markers.markers.push_back(labelMarker(leader_.frame, stamp, 0, leader_.name, 0.7));
-  // Who looks at whom: a thin grey line from each follower to its target, in the world frame.
-  Marker links = toMarker(options_.world_frame, stamp, "links", 0, Marker::LINE_LIST,
-                          Eigen::Vector3d::Zero(), 0.04, {0.6F, 0.6F, 0.6F, 0.8F});
-  int id = 1;
-  for (const Follower& follower : followers_) {
-    markers.markers.push_back(toMarker(follower.agent.frame, stamp, "agents", id, Marker::SPHERE,
-                                       Eigen::Vector3d::Zero(), 0.5, {1.0F, 0.55F, 0.0F, 1.0F}));
-    markers.markers.push_back(
-        labelMarker(follower.agent.frame, stamp, id, follower.agent.name, 0.6));
-    for (const Agent* end : {&follower.agent, &targetOf(follower)}) {
-      links.points.push_back(tf2::toMsg(toVector3(end->integrator.state().head(axes_))));
-    }
-    ++id;
-  }
-  markers.markers.push_back(links);
-  marker_publisher_.publish(markers);
 }
 
 GenericDimensions::InputVector PlantWorld::commandAt(Agent* agent, const ros::Time& now) {

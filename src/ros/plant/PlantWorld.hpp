@@ -20,6 +20,7 @@
 
 #include "plant/PlantClock.hpp"
 #include "plant/PlantOptions.hpp"
+#include "plant/PlantVehicles.hpp"
 
 namespace projection_collision_avoidance {
 
@@ -43,6 +44,12 @@ namespace projection_collision_avoidance {
 /// `<follower>/applied_command`. With ~lockstep tick k + 1 does that integration instead, once
 /// the commands answering sample k are in (PlantClock holds simulated time until then), so
 /// that every agent integrates [t_k, t_k+1] with its answer to t_k, as cf_sim does.
+///
+/// An agent listed in ~vehicles with kind `velocity` or `unicycle` is a PlantVehicle instead: it
+/// takes Twists on `<agent>/cmd_vel` (and TwistStamped on `<agent>/cmd_vel_stamped`), publishes
+/// its odometry and tf with its heading and twist in its body frame, and its applied command as
+/// a TwistStamped; its measurements are those of its odometry's origin, as for a double
+/// integrator; the leader's u_d does not act on it, and lockstep does not wait for it.
 ///
 /// Time: PlantClock. With publish_clock the plant owns simulated time (stamps t_k from 0), ticking
 /// on a wall timer at rate * real_time_factor (catching up ticks that a late callback missed).
@@ -69,6 +76,12 @@ class PlantWorld {
     ros::Subscriber command_subscriber;
     ros::Publisher odom_publisher;
     ros::Publisher applied_command_publisher;  ///< the command integrated over each tick
+    std::unique_ptr<PlantVehicle> vehicle;     ///< a vehicle kind; null: the double integrator
+
+    /// [p; v] of the agent (2 axes entries).
+    Eigen::VectorXd state() const {
+      return vehicle ? vehicle->state() : Eigen::VectorXd(integrator.state());
+    }
   };
 
   /// A follower: its agent, its target and its measurement topic.
@@ -78,7 +91,16 @@ class PlantWorld {
     ros::Publisher measurement_publisher;
   };
 
+  /// Makes @p agent the vehicle ~vehicles asks for, if any (from its initial state).
+  void attachVehicle(Agent* agent);
+  /// Advertises the agent's outputs and subscribes its command input.
+  void connectAgent(Agent* agent);
+  /// The plant's time: the last tick's stamp, or ROS time before the clock runs.
+  ros::Time plantNow() const { return clock_ ? clock_->now() : ros::Time::now(); }
   void onCommand(Agent* agent, const geometry_msgs::AccelStamped::ConstPtr& msg);
+  /// Publishes the agent's odometry at @p stamp and appends its transform.
+  void sampleAgent(Agent* agent, const ros::Time& stamp,
+                   std::vector<geometry_msgs::TransformStamped>* transforms);
   /// Samples, publishes and integrates tick k (mutex_ held); false once the duration is
   /// reached (and then requests the shutdown).
   bool tick(long k);

@@ -1,0 +1,194 @@
+#include "plant/PlantVehicles.hpp"
+
+#include <cmath>
+#include <utility>
+
+#include <nav_msgs/Odometry.h>
+#include <tf2_eigen/tf2_eigen.h>
+
+#include "projection_collision_avoidance/ros/InputAdmission.hpp"
+#include "projection_collision_avoidance/ros/MessageConversions.hpp"
+
+namespace projection_collision_avoidance {
+namespace {
+
+/// A velocity across the unicycle's heading smaller than this (m/s) is not worth a warning.
+constexpr double kDroppedVelocityTolerance = 1e-9;
+
+bool allFinite(const geometry_msgs::Twist& twist) {
+  return std::isfinite(twist.linear.x) && std::isfinite(twist.linear.y) &&
+         std::isfinite(twist.linear.z) && std::isfinite(twist.angular.x) &&
+         std::isfinite(twist.angular.y) && std::isfinite(twist.angular.z);
+}
+
+/// R_z(ψ) v.
+Eigen::Vector3d turned(double psi, const Eigen::Vector3d& v) {
+  const double c = std::cos(psi);
+  const double s = std::sin(psi);
+  return {c * v.x() - s * v.y(), s * v.x() + c * v.y(), v.z()};
+}
+
+}  // namespace
+
+PlantVehicle::PlantVehicle(const VehicleOptions& options, Setup setup,
+                           const Eigen::VectorXd& initial_state)
+    : kind_(options.kind),
+      twist_in_body_(options.twist_in_body),
+      setup_(std::move(setup)),
+      twist_guard_(setup_.agent_name + "/cmd_vel", InputGuardLimits{}),
+      stamped_guard_(setup_.agent_name + "/cmd_vel_stamped", InputGuardLimits{}) {
+  const int k = setup_.axes;
+  const Eigen::Vector3d p0 = toVector3(initial_state.head(k));
+  const Eigen::Vector3d v0 = toVector3(initial_state.tail(k));
+  if (kind_ == VehicleKind::kVelocity) {
+    velocity_.emplace(
+        k, p0, v0, VelocityLagParameters{options.velocity_lag, options.max_speed, options.heading},
+        options.key);
+    return;
+  }
+  UnicycleState start;
+  start.x = p0.x();
+  start.y = p0.y();
+  start.theta = options.heading;
+  start.v = v0.x() * std::cos(options.heading) + v0.y() * std::sin(options.heading);
+  z_ = p0.z();
+  unicycle_.emplace(
+      start, UnicycleParameters{options.velocity_lag, options.max_speed, options.max_yaw_rate},
+      options.key);
+  const double across = -v0.x() * std::sin(options.heading) + v0.y() * std::cos(options.heading);
+  if (std::abs(across) > kDroppedVelocityTolerance ||
+      std::abs(v0.z()) > kDroppedVelocityTolerance) {
+    ROS_WARN_STREAM(setup_.node_name << ": " << setup_.agent_name
+                                     << " is a unicycle: of its initial velocity only the part "
+                                        "along its heading is kept, "
+                                     << start.v << " m/s");
+  }
+}
+
+void PlantVehicle::connect(ros::NodeHandle& nh, std::mutex* mutex, std::function<ros::Time()> now) {
+  mutex_ = mutex;
+  now_ = std::move(now);
+  const std::string& agent = setup_.agent_name;
+  odom_publisher_ = nh.advertise<nav_msgs::Odometry>(agent + "/odom", 10);
+  applied_publisher_ = nh.advertise<geometry_msgs::TwistStamped>(agent + "/applied_command", 10);
+  twist_subscriber_ = nh.subscribe<geometry_msgs::Twist>(
+      agent + "/cmd_vel", 10,
+      [this](const geometry_msgs::Twist::ConstPtr& msg) { onTwist(&twist_guard_, *msg); },
+      ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
+  stamped_subscriber_ = nh.subscribe<geometry_msgs::TwistStamped>(
+      agent + "/cmd_vel_stamped", 10,
+      [this](const geometry_msgs::TwistStamped::ConstPtr& msg) {
+        onTwist(&stamped_guard_, msg->twist);
+      },
+      ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
+}
+
+bool PlantVehicle::commandOf(const geometry_msgs::Twist& twist, Eigen::Vector3d* command,
+                             std::string* why) const {
+  if (!allFinite(twist)) {
+    *why = "non-finite field";
+    return false;
+  }
+  if (kind_ == VehicleKind::kUnicycle) {
+    *command = Eigen::Vector3d(twist.linear.x, twist.angular.z, 0.0);
+    return true;
+  }
+  const Eigen::Vector3d linear(twist.linear.x, twist.linear.y, twist.linear.z);
+  *command = twist_in_body_ ? turned(velocity_->heading(), linear) : linear;
+  return true;
+}
+
+void PlantVehicle::onTwist(InputGuard* guard, const geometry_msgs::Twist& twist) {
+  const std::lock_guard<std::mutex> lock(*mutex_);
+  admitGuarded(*guard, setup_.node_name, [&] {
+    std::string why;
+    Eigen::Vector3d command;
+    if (!commandOf(twist, &command, &why)) {
+      guard->reject(Rejection::kContent, why);
+      return;
+    }
+    const ros::Time now = now_();
+    if (!have_command_ && !twist_guard_.everAccepted() && !stamped_guard_.everAccepted()) {
+      ROS_INFO_STREAM(setup_.node_name << ": first " << setup_.agent_name << " velocity command");
+    }
+    command_ = command;
+    have_command_ = true;
+    received_ = now;
+    guard->accept(nanosecondsOf(now), nanosecondsOf(now));
+  });
+}
+
+Eigen::VectorXd PlantVehicle::state() const {
+  const int k = setup_.axes;
+  Eigen::VectorXd state(2 * k);
+  if (velocity_) {
+    state << velocity_->position().head(k), velocity_->velocity().head(k);
+    return state;
+  }
+  const UnicycleState& s = unicycle_->state();
+  const Eigen::Vector2d v = unicycle_->worldVelocity();
+  state << Eigen::Vector3d(s.x, s.y, z_).head(k), Eigen::Vector3d(v.x(), v.y(), 0.0).head(k);
+  return state;
+}
+
+double PlantVehicle::yaw() const {
+  return velocity_ ? velocity_->heading() : unicycle_->state().theta;
+}
+
+void PlantVehicle::publishSample(const ros::Time& stamp,
+                                 std::vector<geometry_msgs::TransformStamped>* transforms) const {
+  Eigen::Vector3d position;
+  Eigen::Vector3d linear;
+  Eigen::Vector3d angular = Eigen::Vector3d::Zero();
+  if (velocity_) {
+    position = velocity_->position();
+    linear = velocity_->bodyVelocity();
+  } else {
+    const UnicycleState& s = unicycle_->state();
+    position = Eigen::Vector3d(s.x, s.y, z_);
+    linear = Eigen::Vector3d(s.v, 0.0, 0.0);
+    angular.z() = s.omega;
+  }
+  odom_publisher_.publish(
+      toBodyOdometryMsg(position, yaw(), linear, angular, stamp, setup_.world_frame, setup_.frame));
+  transforms->push_back(toTransformMsg(position, yaw(), stamp, setup_.world_frame, setup_.frame));
+}
+
+void PlantVehicle::advance(double h, const ros::Time& stamp) {
+  const bool fresh =
+      have_command_ && std::abs(secondsBetween(stamp, received_)) <= setup_.command_timeout;
+  if (fresh && timed_out_) {
+    ROS_INFO_STREAM(setup_.node_name << ": " << setup_.agent_name
+                                     << " velocity command fresh again");
+    timed_out_ = false;
+  } else if (!fresh && have_command_ && !timed_out_) {
+    ROS_WARN_STREAM(setup_.node_name << ": " << setup_.agent_name << " velocity command is "
+                                     << secondsBetween(stamp, received_)
+                                     << " s old, more than ~command_timeout ("
+                                     << setup_.command_timeout << " s): stopping");
+    timed_out_ = true;
+  }
+  const Eigen::Vector3d command = fresh ? command_ : Eigen::Vector3d::Zero();
+  geometry_msgs::TwistStamped applied;
+  applied.header.stamp = stamp;
+  if (velocity_) {
+    velocity_->setCommand(command);
+    velocity_->advance(h);
+    applied.header.frame_id = setup_.world_frame;
+    tf2::toMsg(velocity_->command(), applied.twist.linear);
+  } else {
+    unicycle_->setCommand(command.x(), command.y());
+    unicycle_->advance(h);
+    applied.header.frame_id = setup_.frame;
+    applied.twist.linear.x = unicycle_->commandSpeed();
+    applied.twist.angular.z = unicycle_->commandYawRate();
+  }
+  applied_publisher_.publish(applied);
+}
+
+void PlantVehicle::restartTimeline() {
+  have_command_ = false;
+  timed_out_ = false;
+}
+
+}  // namespace projection_collision_avoidance
