@@ -8,6 +8,7 @@
 #include <geometry_msgs/Vector3Stamped.h>
 
 #include "projection_collision_avoidance/ros/MessageConversions.hpp"
+#include "projection_collision_avoidance/ros/OdometryFrames.hpp"
 #include "projection_collision_avoidance/ros/RosParameters.hpp"
 
 #include "adapter/CommandAdapterOptions.hpp"
@@ -45,6 +46,7 @@ CommandAdapter::CommandAdapter(ros::NodeHandle nh, ros::NodeHandle private_nh)
       command_guard_("command", {"", 0.1, options_->command_timeout}),
       odometry_guard_("odom", {"", 0.1, 0.0}),
       base_frame_(options_->base_frame),
+      world_frame_(options_->world_frame),
       acceleration_(Eigen::VectorXd::Zero(options_->converter.axes)) {
   if (options_->accel_enu) {
     accel_publisher_ = nh.advertise<geometry_msgs::Vector3Stamped>("setpoint_accel", 10);
@@ -55,6 +57,7 @@ CommandAdapter::CommandAdapter(ros::NodeHandle nh, ros::NodeHandle private_nh)
   if (options_->twist_stamped) {
     twist_stamped_publisher_ = nh.advertise<geometry_msgs::TwistStamped>("cmd_vel_stamped", 10);
   }
+  tf_listener_ = std::make_unique<tf2_ros::TransformListener>(tf_buffer_, nh);
   odometry_subscriber_ = nh.subscribe("odom", 10, &CommandAdapter::onOdometry, this,
                                       ros::TransportHints().tcpNoDelay());
   command_subscriber_ = nh.subscribe("command", 10, &CommandAdapter::onCommand, this,
@@ -85,7 +88,16 @@ void CommandAdapter::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
     if (!checkHeader(odometry_guard_, msg->header, now)) {
       return;
     }
-    if (!converter_.observe(toOdometrySample(*msg))) {
+    // The heading in the world frame of the commands (tf2 when the odometry's frame differs).
+    OdometrySample sample;
+    std::string why;
+    if (!odometryInFrame(*msg, options_->world_frame,
+                         options_->converter.odometry_twist_frame == TwistFrame::kBody, tf_buffer_,
+                         0.0, &sample, &why)) {
+      odometry_guard_.reject(Rejection::kContent, why);
+      return;
+    }
+    if (!converter_.observe(sample)) {
       odometry_guard_.reject(Rejection::kContent,
                              "non-finite field or an orientation that is not a unit quaternion");
       return;
@@ -94,6 +106,7 @@ void CommandAdapter::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
     if (options_->base_frame.empty()) {
       base_frame_ = msg->child_frame_id;
     }
+    world_frame_ = options_->world_frame.empty() ? msg->header.frame_id : options_->world_frame;
   });
 }
 
@@ -114,7 +127,6 @@ void CommandAdapter::onCommand(const geometry_msgs::AccelStamped::ConstPtr& msg)
       return;
     }
     command_guard_.accept(nanosecondsOf(msg->header.stamp), nanosecondsOf(now));
-    command_frame_ = msg->header.frame_id;
     const ConvertedCommand& command = converter_.convert(acceleration_, now.toSec());
     if (!command.heading_known) {
       ROS_WARN_STREAM_THROTTLE(5.0, name_ << ": no fresh own odometry (odom) for the heading: "
@@ -143,7 +155,7 @@ void CommandAdapter::publish(const ConvertedCommand& command, const ros::Time& s
   if (options_->accel_enu) {
     geometry_msgs::Vector3Stamped accel;
     accel.header.stamp = stamp;
-    accel.header.frame_id = command_frame_;
+    accel.header.frame_id = world_frame_;
     accel.vector = toVector3Msg(command.acceleration);
     accel_publisher_.publish(accel);
   }
@@ -162,7 +174,7 @@ void CommandAdapter::publish(const ConvertedCommand& command, const ros::Time& s
     stamped.header.stamp = stamp;
     stamped.header.frame_id = options_->unicycle || options_->converter.velocity_in_base_frame
                                   ? base_frame_
-                                  : command_frame_;
+                                  : world_frame_;
     stamped.twist = twist;
     twist_stamped_publisher_.publish(stamped);
   }

@@ -7,6 +7,8 @@
 #include <geometry_msgs/AccelStamped.h>
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_listener.h>
 
 #include "projection_collision_avoidance/ros/InputAdmission.hpp"
 #include "projection_collision_avoidance/ros/InputGuard.hpp"
@@ -20,9 +22,11 @@ struct CommandAdapterOptions;
 /// The follower's command for a vehicle stack (node `command_adapter`, nodelet
 /// CommandAdapterNodelet; doc/vehicles.md). Subscribes `command` (geometry_msgs/AccelStamped:
 /// the follower's acceleration, world frame) and the vehicle's own `odom` (nav_msgs/Odometry:
-/// heading and measured velocity, twist in child_frame_id as REP 105 says) and publishes, for
+/// heading and measured velocity, twist in child_frame_id as REP 105 says; moved into
+/// ~world_frame with tf2 when that is set and its frame differs) and publishes, for
 /// each command, the ~outputs chosen: `setpoint_accel` (geometry_msgs/Vector3Stamped, the
-/// acceleration in the command's frame, ENU as MAVROS's setpoint_accel plugin takes it),
+/// acceleration in the world frame: the follower's command is in the axes of its measurements,
+/// whatever its frame_id, ENU as MAVROS's setpoint_accel plugin takes it),
 /// `cmd_vel` (geometry_msgs/Twist: the velocity command, world or base frame, or a unicycle's
 /// v and ω) and `cmd_vel_stamped` (geometry_msgs/TwistStamped). CommandConverter makes them.
 ///
@@ -56,10 +60,12 @@ class CommandAdapter {
   ClockWatch command_clock_;
   InputGuard odometry_guard_;
   ClockWatch odometry_clock_;
-  std::string command_frame_;  ///< frame_id of the latest accepted command
-  std::string base_frame_;     ///< ~base_frame, or the own odometry's child_frame_id
+  std::string world_frame_;  ///< ~world_frame, or the own odometry's header.frame_id
+  std::string base_frame_;   ///< ~base_frame, or the own odometry's child_frame_id
   Eigen::VectorXd acceleration_;
 
+  tf2_ros::Buffer tf_buffer_;
+  std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
   ros::Publisher accel_publisher_;
   ros::Publisher twist_publisher_;
   ros::Publisher twist_stamped_publisher_;

@@ -90,6 +90,7 @@ CommandAdapterOptions readCommandAdapterOptions(NodeOptionReader& reader) {
   c.unicycle_limits.max_yaw_rate = limitOrNone(reader, "unicycle/max_yaw_rate", 1e4);
   c.stop_deceleration = reader.number("stop_deceleration", c.stop_deceleration, 1e-3, 1e3);
   options.base_frame = reader.text("base_frame", "");
+  options.world_frame = reader.text("world_frame", "");
   return options;
 }
 

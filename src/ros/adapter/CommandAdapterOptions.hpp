@@ -17,6 +17,8 @@ struct CommandAdapterOptions {
   double command_timeout = 0.25;  ///< steady s without a command before the stop is sent
   double watchdog_rate = 20.0;    ///< Hz (steady time) of the timeout checks and repeated stops
   std::string base_frame;  ///< frame_id of base-frame stamped outputs ("": the odometry's child)
+  /// The follower's world frame (its measurements' frame); "": the own odometry's header frame.
+  std::string world_frame;
 };
 
 /// The options, each validated (the message names the key): ~outputs (a space-separated set of
@@ -24,7 +26,7 @@ struct CommandAdapterOptions {
 /// refused together), ~axes, ~control_rate, ~command_timeout, ~watchdog_rate,
 /// ~odometry/max_age, ~odometry/twist_frame, ~velocity/max_speed, ~velocity/lag,
 /// ~velocity/frame, ~unicycle/look_ahead, ~unicycle/max_speed, ~unicycle/max_yaw_rate,
-/// ~stop_deceleration, ~base_frame.
+/// ~stop_deceleration, ~base_frame, ~world_frame.
 CommandAdapterOptions readCommandAdapterOptions(NodeOptionReader& reader);
 
 }  // namespace projection_collision_avoidance

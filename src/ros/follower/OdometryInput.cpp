@@ -4,11 +4,7 @@
 #include <limits>
 #include <utility>
 
-#include <Eigen/Geometry>
-#include <tf2/exceptions.h>
-#include <tf2_eigen/tf2_eigen.h>
-
-#include "projection_collision_avoidance/ros/MessageConversions.hpp"
+#include "projection_collision_avoidance/ros/OdometryFrames.hpp"
 
 namespace projection_collision_avoidance {
 namespace {
@@ -18,7 +14,8 @@ OdometryAlignmentOptions alignmentOptions(const OdometryInputOptions& o, int axe
   a.axes = axes;
   a.max_skew = o.max_skew;
   a.quaternion_tolerance = o.quaternion_tolerance;
-  // A twist in the header frame is rotated into the world frame with the pose (toWorld()).
+  // A twist in the header frame is rotated into the world frame with the pose
+  // (odometryInFrame()).
   a.twist_frame = o.twist_in_body_frame ? TwistFrame::kBody : TwistFrame::kWorld;
   a.self_point = Eigen::Vector3d(o.look_ahead, 0.0, 0.0);
   a.target_point = Eigen::Vector3d(o.target_look_ahead, 0.0, 0.0);
@@ -73,7 +70,8 @@ void OdometryInput::onOdometry(Side* side, const nav_msgs::Odometry::ConstPtr& m
     }
     std::string why;
     OdometrySample sample;
-    if (!toWorld(*msg, &sample, &why)) {
+    if (!odometryInFrame(*msg, world_frame_, options_.odometry.twist_in_body_frame, tf_buffer_,
+                         options_.odometry.tf_timeout, &sample, &why)) {
       side->guard.reject(Rejection::kContent, why);
       return;
     }
@@ -92,32 +90,6 @@ void OdometryInput::onOdometry(Side* side, const nav_msgs::Odometry::ConstPtr& m
     }
   });
   rejected_.fetch_add(side->guard.rejected() - before, std::memory_order_relaxed);
-}
-
-bool OdometryInput::toWorld(const nav_msgs::Odometry& msg, OdometrySample* sample,
-                            std::string* why) {
-  *sample = toOdometrySample(msg);
-  if (msg.header.frame_id == world_frame_ || world_frame_.empty()) {
-    return true;
-  }
-  geometry_msgs::TransformStamped transform;
-  try {
-    transform = tf_buffer_.lookupTransform(world_frame_, msg.header.frame_id, msg.header.stamp,
-                                           ros::Duration(options_.odometry.tf_timeout));
-  } catch (const tf2::TransformException& error) {
-    *why = "no transform from \"" + msg.header.frame_id.substr(0, InputGuard::kMaxQuotedLength) +
-           "\" to \"" + world_frame_ + "\": " + error.what();
-    return false;
-  }
-  const Eigen::Isometry3d world_from_frame = tf2::transformToEigen(transform);
-  const Eigen::Matrix3d rotation = world_from_frame.rotation();
-  sample->position = world_from_frame * sample->position;
-  sample->orientation = Eigen::Quaterniond(rotation) * sample->orientation;
-  if (!options_.odometry.twist_in_body_frame) {  // a twist in the header frame turns with it
-    sample->linear_velocity = rotation * sample->linear_velocity;
-    sample->angular_velocity = rotation * sample->angular_velocity;
-  }
-  return true;
 }
 
 bool OdometryInput::controlledPoint(std::string* frame, Eigen::Vector3d* point) {

@@ -62,8 +62,6 @@ class OdometryInput {
   };
 
   void onOdometry(Side* side, const nav_msgs::Odometry::ConstPtr& msg);
-  /// @p msg's sample in the world frame; false with the reason in @p why (a tf lookup failed).
-  bool toWorld(const nav_msgs::Odometry& msg, OdometrySample* sample, std::string* why);
   /// The relative state of the latest pair to the sink (mutex_ held), or a refusal counted.
   void combine();
 

@@ -67,6 +67,12 @@ class PlantVehicle {
   void advance(double h, const ros::Time& stamp);
   /// Plant time went back: the held command is forgotten (a stop until the next one).
   void restartTimeline();
+  /// Whether a follower drives it: its odometry has a subscriber and cmd_vel or cmd_vel_stamped
+  /// a publisher.
+  bool driven() const {
+    return odom_publisher_.getNumSubscribers() > 0 &&
+           (twist_subscriber_.getNumPublishers() > 0 || stamped_subscriber_.getNumPublishers() > 0);
+  }
   /// The body frame's yaw in the world (rad).
   double yaw() const;
 

@@ -116,7 +116,12 @@ PlantWorld::PlantWorld(ros::NodeHandle nh, ros::NodeHandle private_nh)
   hooks.listening = [this] {
     int listening = 0;
     for (const Follower& follower : followers_) {
-      listening += follower.measurement_publisher.getNumSubscribers() > 0 ? 1 : 0;
+      // A vehicle's follower listens to odometry and drives it through cmd_vel.
+      const PlantVehicle* vehicle = follower.agent.vehicle.get();
+      const bool listens = vehicle != nullptr
+                               ? vehicle->driven()
+                               : follower.measurement_publisher.getNumSubscribers() > 0;
+      listening += listens ? 1 : 0;
     }
     return std::make_pair(listening, static_cast<int>(followers_.size()));
   };

@@ -1,0 +1,26 @@
+#pragma once
+
+/// @file
+/// An odometry message brought into another world frame with tf2: the one frame change the
+/// follower's odometry input and the command adapter share.
+
+#include <string>
+
+#include <nav_msgs/Odometry.h>
+#include <tf2_ros/buffer.h>
+
+#include "projection_collision_avoidance/vehicle/RelativeStateFromOdometry.hpp"
+
+namespace projection_collision_avoidance {
+
+/// @p msg as an OdometrySample in @p world_frame: unchanged when its header.frame_id is that
+/// frame (or @p world_frame is empty); otherwise pose (p_W = T p, q_W = R q) and, for a twist in
+/// the header frame (@p twist_in_body_frame false), the twist (v_W = R v, ω_W = R ω) moved by the
+/// transform world ← header.frame_id that @p tf_buffer holds at the message's stamp, waiting at
+/// most @p tf_timeout s. A body-frame twist stays as it is (its body now has orientation q_W).
+/// @return false, with the reason in @p why, when there is no such transform
+bool odometryInFrame(const nav_msgs::Odometry& msg, const std::string& world_frame,
+                     bool twist_in_body_frame, const tf2_ros::Buffer& tf_buffer, double tf_timeout,
+                     OdometrySample* sample, std::string* why);
+
+}  // namespace projection_collision_avoidance

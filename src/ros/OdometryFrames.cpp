@@ -1,0 +1,39 @@
+#include "projection_collision_avoidance/ros/OdometryFrames.hpp"
+
+#include <Eigen/Geometry>
+#include <tf2/exceptions.h>
+#include <tf2_eigen/tf2_eigen.h>
+
+#include "projection_collision_avoidance/ros/InputGuard.hpp"
+#include "projection_collision_avoidance/ros/MessageConversions.hpp"
+
+namespace projection_collision_avoidance {
+
+bool odometryInFrame(const nav_msgs::Odometry& msg, const std::string& world_frame,
+                     bool twist_in_body_frame, const tf2_ros::Buffer& tf_buffer, double tf_timeout,
+                     OdometrySample* sample, std::string* why) {
+  *sample = toOdometrySample(msg);
+  if (world_frame.empty() || msg.header.frame_id == world_frame) {
+    return true;
+  }
+  geometry_msgs::TransformStamped transform;
+  try {
+    transform = tf_buffer.lookupTransform(world_frame, msg.header.frame_id, msg.header.stamp,
+                                          ros::Duration(tf_timeout));
+  } catch (const tf2::TransformException& error) {
+    *why = "no transform from \"" + boundedText(msg.header.frame_id, InputGuard::kMaxQuotedLength) +
+           "\" to \"" + world_frame + "\": " + error.what();
+    return false;
+  }
+  const Eigen::Isometry3d world_from_frame = tf2::transformToEigen(transform);
+  const Eigen::Matrix3d rotation = world_from_frame.rotation();
+  sample->position = world_from_frame * sample->position;
+  sample->orientation = Eigen::Quaterniond(rotation) * sample->orientation;
+  if (!twist_in_body_frame) {  // a twist in the header frame turns with it
+    sample->linear_velocity = rotation * sample->linear_velocity;
+    sample->angular_velocity = rotation * sample->angular_velocity;
+  }
+  return true;
+}
+
+}  // namespace projection_collision_avoidance
