@@ -63,6 +63,17 @@ OwnStateSample ownStateAt(std::int64_t stamp_ns, std::uint64_t sequence, double 
   return own;
 }
 
+/// Ticks every millisecond (ROS and steady time alike, on time) from @p from_ns to @p to_ns, both
+/// included; returns the number of steps, with @p out the last tick's output.
+int tickEachMs(FollowerCycle* cycle, std::int64_t from_ns, std::int64_t to_ns,
+               FollowerCycleOutput* out) {
+  int steps = 0;
+  for (std::int64_t t = from_ns; t <= to_ns; t += kMs) {
+    steps += cycle->tick(t, 0.0, 0, out) ? 1 : 0;
+  }
+  return steps;
+}
+
 TEST(FollowerCycle, TheControlThreadAllocatesAndFreesNothing) {
   FollowerCycleSettings settings;
   settings.use_leader_input = true;
@@ -156,7 +167,7 @@ TEST(FollowerCycle, ModesFromTheInputsAges) {
   EXPECT_NEAR(out.measurement_age, 0.001, 1e-12);
   EXPECT_NEAR(out.distance, 5.0, 1e-12);
   // Older than the 0.5 s timeout: the braking fallback.
-  ASSERT_TRUE(cycle->tick(kStart + 600 * kMs, 0.0, 0, &out));
+  EXPECT_EQ(tickEachMs(cycle.get(), kStart + 2 * kMs, kStart + 600 * kMs, &out), 599);
   EXPECT_EQ(out.mode, FollowerMode::kMeasurementLost);
   EXPECT_TRUE(out.status.fallback);
 }
@@ -175,6 +186,7 @@ TEST(FollowerCycle, ATimeHeadwayStepsWithTheOwnStateWhileItIsFresh) {
   EXPECT_TRUE(out.own_state_fresh);
   EXPECT_GT(out.status.headway_command.norm(), 0.0);
   // The odometry older than the measurement timeout (0.5 s): the headway is left out.
+  tickEachMs(cycle.get(), kStart + 3 * kMs, kStart + 599 * kMs, &out);
   cycle->measurement().write(measurementAt(kStart + 600 * kMs, 3, 5.0));
   ASSERT_TRUE(cycle->tick(kStart + 600 * kMs, 0.0, 0, &out));
   EXPECT_EQ(out.mode, FollowerMode::kTracking);
@@ -269,7 +281,8 @@ TEST(FollowerCycle, AfterAStallItWaitsForTheInputSentMeanwhile) {
   EXPECT_EQ(out.mode, FollowerMode::kTracking);
   // Without a new measurement the wait ends after half the timeout: then the fallback.
   EXPECT_FALSE(cycle->tick(kStart + 5000 * kMs, 2.0, 0, &out));
-  ASSERT_TRUE(cycle->tick(kStart + 5300 * kMs, 0.0, 0, &out));
+  EXPECT_EQ(tickEachMs(cycle.get(), kStart + 5001 * kMs, kStart + 5249 * kMs, &out), 0);
+  ASSERT_TRUE(cycle->tick(kStart + 5250 * kMs, 0.0, 0, &out));
   EXPECT_EQ(out.mode, FollowerMode::kMeasurementLost);
 }
 
@@ -292,8 +305,68 @@ TEST(FollowerCycle, TheWaitAfterAStallIsMeasuredOnTheSteadyClock) {
   EXPECT_EQ(out.mode, FollowerMode::kTracking);
   // Half the timeout of steady time without a measurement ends the wait: then the fallback.
   EXPECT_FALSE(cycle->tick(kStart + 6000 * kMs, steady + 4500 * kMs, 2.0, 0, &out));
-  ASSERT_TRUE(cycle->tick(kStart + 6010 * kMs, steady + 4800 * kMs, 0.0, 0, &out));
+  for (int k = 1; k < 250; ++k) {
+    EXPECT_FALSE(cycle->tick(kStart + (6000 + k) * kMs, steady + (4500 + k) * kMs, 0.0, 0, &out));
+  }
+  ASSERT_TRUE(cycle->tick(kStart + 6250 * kMs, steady + 4750 * kMs, 0.0, 0, &out));
   EXPECT_EQ(out.mode, FollowerMode::kMeasurementLost);
+}
+
+TEST(FollowerCycle, AClockReplayedPeriodByPeriodAfterAStallIsAStallToo) {
+  // A simulated clock replays the 2 s the process stood still period by period: each tick looks
+  // on time on ROS time, but 2 s of steady time passed since the one before. The newest
+  // measurements are refused as stamped ahead of the replaying clock (noteFutureMeasurement()):
+  // the wait goes on past half the timeout until the clock has caught up and one is accepted.
+  std::unique_ptr<FollowerCycle> cycle = makeCycle();
+  FollowerCycleOutput out;
+  const std::int64_t steady = 1000 * kMs;
+  cycle->measurement().write(measurementAt(kStart, 1, 5.0));
+  ASSERT_TRUE(cycle->tick(kStart + kMs, steady, 0.0, 0, &out));
+  cycle->noteFutureMeasurement();
+  EXPECT_FALSE(cycle->tick(kStart + 2 * kMs, steady + 2001 * kMs, 0.0, 0, &out));
+  EXPECT_GT(out.stall, 1.9);
+  for (int k = 1; k <= 400; ++k) {  // 400 ms of steady time, ROS time replaying 2 s
+    cycle->noteFutureMeasurement();
+    EXPECT_FALSE(cycle->tick(kStart + (2 + 5 * k) * kMs, steady + (2001 + k) * kMs, 0.0, 0, &out))
+        << k;
+  }
+  cycle->measurement().write(measurementAt(kStart + 2002 * kMs, 2, 5.0));
+  ASSERT_TRUE(cycle->tick(kStart + 2003 * kMs, steady + 2402 * kMs, 0.0, 0, &out));
+  EXPECT_EQ(out.mode, FollowerMode::kTracking);
+}
+
+TEST(FollowerCycle, WithoutRefusalsAsFutureAStallOnTheSteadyClockAloneDoesNotWait) {
+  // A lockstep simulation that stood still with everyone else: 2 s of steady time between two
+  // ticks one period apart on ROS time, no measurement refused: the tick steps at once.
+  std::unique_ptr<FollowerCycle> cycle = makeCycle();
+  FollowerCycleOutput out;
+  const std::int64_t steady = 1000 * kMs;
+  cycle->measurement().write(measurementAt(kStart, 1, 5.0));
+  ASSERT_TRUE(cycle->tick(kStart + kMs, steady, 0.0, 0, &out));
+  ASSERT_TRUE(cycle->tick(kStart + 2 * kMs, steady + 2001 * kMs, 0.0, 0, &out));
+  EXPECT_EQ(out.mode, FollowerMode::kTracking);
+  EXPECT_GT(out.stall, 1.9);  // reported all the same
+}
+
+TEST(FollowerCycle, RefusalsAsFutureExtendTheWaitAtMostAsLongAsTheStall) {
+  // A sender whose stamps are always refused as future: the wait after a 2 s stall ends after
+  // max(measurement timeout, 2 s) of steady time, then the fallback brakes.
+  std::unique_ptr<FollowerCycle> cycle = makeCycle();
+  FollowerCycleOutput out;
+  cycle->measurement().write(measurementAt(kStart, 1, 5.0));
+  ASSERT_TRUE(cycle->tick(kStart + kMs, 0.0, 0, &out));
+  EXPECT_FALSE(cycle->tick(kStart + 2001 * kMs, 2.0, 199, &out));
+  int steps = 0;
+  std::int64_t first_step = 0;
+  for (std::int64_t t = kStart + 2002 * kMs; t <= kStart + 4100 * kMs; t += kMs) {
+    cycle->noteFutureMeasurement();
+    if (cycle->tick(t, 0.0, 0, &out) && steps++ == 0) {
+      first_step = t;
+    }
+  }
+  EXPECT_EQ(first_step, kStart + 4001 * kMs);  // 2 s after the stall was seen
+  EXPECT_EQ(out.mode, FollowerMode::kMeasurementLost);
+  EXPECT_EQ(steps, 100);
 }
 
 TEST(FollowerCycle, TheMeasurementTriggerStepsOnMeasurementsAndBrakesOnTicks) {
@@ -306,7 +379,9 @@ TEST(FollowerCycle, TheMeasurementTriggerStepsOnMeasurementsAndBrakesOnTicks) {
   EXPECT_EQ(out.stamp_ns, kStart);
   EXPECT_NEAR(out.tick_delay, 0.002, 1e-12);
   EXPECT_FALSE(cycle->tick(kStart + 10 * kMs, 0.0, 0, &out));  // fresh: the tick only counts
-  ASSERT_TRUE(cycle->tick(kStart + 700 * kMs, 0.0, 0, &out));  // stale: it brakes
+  // Stale from 0.5 s on: the ticks brake.
+  EXPECT_EQ(tickEachMs(cycle.get(), kStart + 11 * kMs, kStart + 500 * kMs, &out), 0);
+  EXPECT_EQ(tickEachMs(cycle.get(), kStart + 501 * kMs, kStart + 700 * kMs, &out), 200);
   EXPECT_EQ(out.mode, FollowerMode::kMeasurementLost);
 }
 

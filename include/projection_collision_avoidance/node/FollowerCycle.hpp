@@ -95,10 +95,15 @@ struct FollowerCycleOutput {
 /// Time: every call reads the ROS time `now_ns` after it has latched the inputs. An input is valid
 /// while it was received at or before now (after a jump back of ROS time, those of the old timeline
 /// are not, so the follower brakes until new ones arrive); its age counts from min(stamp, receipt).
-/// A tick more than half the measurement timeout late (a stalled process) starts a wait: ticks are
-/// skipped and counted as missed until a measurement arrives or half the timeout has passed on the
-/// steady clock (simulated time can catch up by seconds within a millisecond when a stalled process
-/// resumes, before the measurements sent meanwhile are read).
+/// A stalled process (a tick more than half the measurement timeout late on ROS time, or that long
+/// after the tick before on the steady clock) starts a wait: ticks are skipped and counted as
+/// missed until a measurement is accepted, or half the timeout has passed on the steady clock
+/// since the wait began (late on ROS time only) or since the latest measurement refused as
+/// stamped ahead of this clock (noteFutureMeasurement()), but at most max(measurement timeout,
+/// the stall) in all. Simulated
+/// time can catch up by seconds within a millisecond when a stalled process resumes, before the
+/// measurements sent meanwhile are read, or replay the stall period by period, refusing the
+/// newest measurements as future until it has caught up.
 class FollowerCycle {
  public:
   /// @param controller the controller, moved in
@@ -161,6 +166,11 @@ class FollowerCycle {
     return stepOnMeasurement([now_ns] { return now_ns; }, skipped, out);
   }
 
+  /// The input side refused a measurement stamped ahead of this process's clock (any thread,
+  /// lock-free). While a tick waits after a stall, each one extends the wait: the clock is still
+  /// catching up, and measurements will be accepted once it has.
+  void noteFutureMeasurement() { future_measurements_.fetch_add(1, std::memory_order_relaxed); }
+
   /// Hands over a controller for a new design (built elsewhere, e.g. by reconfiguration); a
   /// coming tick adopts it, carrying over the estimate and previous command, once the controller
   /// it replaced last time has been collected with retired(). A controller offered before and
@@ -210,9 +220,18 @@ class FollowerCycle {
   std::int64_t latest_time_ns_ = 0;  ///< latest ROS time seen (jumps back)
   std::uint32_t time_jumps_ = 0;
   double time_jump_ = 0.0;
-  bool resuming_ = false;  ///< waiting for input after a stall
-  std::int64_t resumed_at_steady_ns_ = 0;
+  bool resuming_ = false;                  ///< waiting for input after a stall
+  std::int64_t resumed_at_steady_ns_ = 0;  ///< the wait's start, or the latest future refusal
+  std::int64_t stall_began_steady_ns_ = 0;
+  double wait_limit_ = 0.0;  ///< s of steady time the wait may last in all
   std::uint64_t sequence_at_stall_ = 0;
+  std::atomic<std::uint64_t> future_measurements_{0};  ///< noteFutureMeasurement() calls
+  std::uint64_t future_seen_ = 0;                      ///< the count at the tick before
+  bool have_future_ = false;
+  std::int64_t last_future_steady_ns_ = 0;  ///< the tick that saw the latest future refusal
+  bool wait_anchored_ = false;  ///< the wait has a start: late on ROS time, or a future refusal
+  bool have_last_tick_steady_ = false;
+  std::int64_t last_tick_steady_ns_ = 0;
   double stall_ = 0.0;
 
   FollowerMode mode_ = FollowerMode::kWaiting;

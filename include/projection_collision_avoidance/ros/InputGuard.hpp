@@ -92,6 +92,8 @@ class InputGuard {
   std::uint64_t accepted() const { return accepted_; }
   /// Refusals since start.
   std::uint64_t rejected() const { return rejected_; }
+  /// Kind of the latest refusal (kContent before any).
+  Rejection lastKind() const { return kind_; }
   /// Refusals of the current kind since it began.
   std::uint64_t rejectedOfKind() const { return run_length_; }
   /// The latest refusal ("kind: detail", bounded), "" once a message was accepted after it.

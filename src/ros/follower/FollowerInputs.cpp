@@ -90,6 +90,9 @@ void FollowerInputs::admitMeasurement(const RelativeMeasurement& measurement) {
     const ros::Time now = ros::Time::now();
     if (!admitHeader(measurement_guard_, measurement_clock_, measurement_heard_, msg->header,
                      now)) {
+      if (measurement_guard_.lastKind() == Rejection::kFuture) {
+        cycle_->noteFutureMeasurement();  // this clock may still be catching up after a stall
+      }
       return;
     }
     std::string why;
