@@ -125,11 +125,18 @@ TEST_F(VehiclesTest, TheFormationIsKeptAndNoPerimeterEntered) {
     EXPECT_GT(pairs, 0);
     EXPECT_GE(min_axles, perimeter_[i] - look_ahead - l_target)
         << "the axles closer than the perimeter less the look-ahead distances";
-    std::cout << "follower_" << i << ": statuses " << r.count << ", min distance of the "
-              << "controlled points " << r.min_separation << " m (perimeter " << perimeter_[i]
-              << " m), min axle distance " << min_axles << " m, max ||xi|| " << r.max_xi
-              << " m (xi_max " << xi_max_[i] << " m), final ||xi|| " << r.last.xi_norm << " m"
-              << std::endl;
+    // The figures, in the test's XML report (rosunit-vehicles_<kind>_<topology>.xml).
+    const std::string prefix = "follower_" + std::to_string(i) + "_";
+    const auto record = [&prefix](const std::string& key, double value) {
+      ::testing::Test::RecordProperty(prefix + key, std::to_string(value));
+    };
+    record("statuses", r.count);
+    record("min_distance_controlled_points_m", r.min_separation);
+    record("perimeter_m", perimeter_[i]);
+    record("min_distance_axles_m", min_axles);
+    record("max_xi_m", r.max_xi);
+    record("xi_max_m", xi_max_[i]);
+    record("final_xi_m", r.last.xi_norm);
   }
 }
 
