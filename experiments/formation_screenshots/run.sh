@@ -10,8 +10,10 @@
 #                                 over the ground grid (rviz/formation_3d.rviz)
 #   doc/rviz_formation_chain.png  paper_run2 (1-D), 5 followers, chain, line, 100 Hz, t = 22 s,
 #                                 side view in a 1280x420 window (rviz/formation_line.rviz)
-# Usage: experiments/formation_screenshots/run.sh [2d] [3d] [chain]
-#   (default: all three; ~1 min each)
+#   doc/rviz_vehicles.png         vehicles.launch: 3 differential-drive followers on odometry and
+#                                 cmd_vel, star, V, t = 21.5 s (during the push), formation.rviz
+# Usage: experiments/formation_screenshots/run.sh [2d] [3d] [chain] [vehicles]
+#   (default: all four; ~1 min each)
 #   OUT_DIR (default doc/), REAL_TIME_FACTOR (default 0.5), ROS_PORT (default 11412: its own
 #   master, apart from other tests), SCREEN_DISPLAY (default :98). Needs a built workspace
 #   (scripts/build.sh). The PNGs are reduced to 256 colours (ImageMagick `convert`).
@@ -21,7 +23,8 @@ out=${OUT_DIR:-$root/doc}
 rtf=${REAL_TIME_FACTOR:-0.5}
 port=${ROS_PORT:-11412}
 shots=("$@")
-(( ${#shots[@]} )) || shots=(2d 3d chain)
+(( ${#shots[@]} )) || shots=(2d 3d chain vehicles)
+launch=formation.launch  # the launch file of the current shot
 test -f "$root/build/devel/setup.bash" || "$root/scripts/build.sh" >/dev/null
 set +u  # the workspace's setup scripts read unset variables
 # shellcheck disable=SC1091
@@ -71,7 +74,7 @@ shoot() {
     sleep 0.5
   done
   sleep 3
-  roslaunch --port "$port" projection_collision_avoidance formation.launch rviz:=false \
+  roslaunch --port "$port" projection_collision_avoidance "$launch" rviz:=false \
     sim_time:=true real_time_factor:="$rtf" "$@" >"$work/launch.log" 2>&1 &
   pids+=($!)
   # Wait (bounded) until simulated time passes $at: one subscriber, up before the plant is.
@@ -104,6 +107,9 @@ for shot in "${shots[@]}"; do
     chain) shoot 22 "$out/rviz_formation_chain.png" "$root/rviz/formation_line.rviz" \
           scenario:="$root/config/scenarios/paper_run2.yaml" followers:=5 topology:=chain \
           shape:=line control_rate:=100 ;;
-    *) echo "formation_screenshots: unknown shot '$shot' (2d, 3d, chain)"; exit 1 ;;
+    vehicles) launch=vehicles.launch
+          shoot 21.5 "$out/rviz_vehicles.png" "$root/rviz/formation.rviz" followers:=3 kind:=unicycle
+          launch=formation.launch ;;
+    *) echo "formation_screenshots: unknown shot '$shot' (2d, 3d, chain, vehicles)"; exit 1 ;;
   esac
 done
