@@ -65,7 +65,7 @@ void OdometryInput::onOdometry(Side* side, const nav_msgs::Odometry::ConstPtr& m
     if (!checkHeader(side->guard, msg->header, now)) {
       return;
     }
-    if (side == &self_ && world_frame_.empty()) {
+    if (side == &self_ && options_.measurement_frame.empty()) {
       world_frame_ = msg->header.frame_id;  // the own odometry's frame is the world
     }
     std::string why;
@@ -77,6 +77,8 @@ void OdometryInput::onOdometry(Side* side, const nav_msgs::Odometry::ConstPtr& m
     }
     side->guard.accept(nanosecondsOf(msg->header.stamp), nanosecondsOf(now));
     side->sample = sample;
+    side->frame = world_frame_.empty() ? msg->header.frame_id : world_frame_;
+    side->msg = msg;
     side->stamp = msg->header.stamp;
     side->have = true;
     if (side == &self_) {
@@ -105,6 +107,19 @@ bool OdometryInput::controlledPoint(std::string* frame, Eigen::Vector3d* point) 
 void OdometryInput::combine() {
   if (!self_.have || !target_.have) {
     return;
+  }
+  if (target_.frame != world_frame_) {  // the world frame changed since the target's arrival
+    std::string why;
+    OdometrySample sample;
+    if (!odometryInFrame(*target_.msg, world_frame_, options_.odometry.twist_in_body_frame,
+                         tf_buffer_, options_.odometry.tf_timeout, &sample, &why)) {
+      rejected_pairs_.fetch_add(1, std::memory_order_relaxed);
+      pair_guard_.reject(Rejection::kContent, "the target's odometry: " + why);
+      logRejection(pair_guard_, name_);
+      return;
+    }
+    target_.sample = sample;
+    target_.frame = world_frame_;
   }
   const RelativeOdometryResult result = relative_.compute(self_.sample, target_.sample);
   if (!result.accepted()) {

@@ -56,7 +56,9 @@ class OdometryInput {
   struct Side {
     InputGuard guard;
     ClockWatch clock;
-    OdometrySample sample;
+    OdometrySample sample;  ///< in `frame`
+    std::string frame;
+    nav_msgs::Odometry::ConstPtr msg;  ///< as received
     ros::Time stamp;
     bool have = false;
   };
@@ -70,7 +72,7 @@ class OdometryInput {
   int axes_;
   Sink sink_;
   RelativeStateFromOdometry relative_;
-  std::string world_frame_;  ///< "" until the first own odometry names it (no ~measurement_frame)
+  std::string world_frame_;  ///< ~measurement_frame, else the latest own odometry's frame
 
   std::mutex mutex_;  ///< the two subscriptions may call at once (nodelets)
   Side self_;
