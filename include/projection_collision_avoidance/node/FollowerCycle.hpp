@@ -100,10 +100,9 @@ struct FollowerCycleOutput {
 /// missed until a measurement is accepted, or half the timeout has passed on the steady clock
 /// since the wait began (late on ROS time only) or since the latest measurement refused as
 /// stamped ahead of this clock (noteFutureMeasurement()), but at most max(measurement timeout,
-/// the stall) in all. Simulated
-/// time can catch up by seconds within a millisecond when a stalled process resumes, before the
-/// measurements sent meanwhile are read, or replay the stall period by period, refusing the
-/// newest measurements as future until it has caught up.
+/// the stall) in all. Simulated time can catch up by seconds within a millisecond when a stalled
+/// process resumes, before the measurements sent meanwhile are read, or replay the stall period by
+/// period, refusing the newest measurements as future until it has caught up.
 class FollowerCycle {
  public:
   /// @param controller the controller, moved in
