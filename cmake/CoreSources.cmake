@@ -48,6 +48,7 @@ set(PCA_VEHICLE_SOURCES
   src/vehicle/CommandConverter.cpp
   src/vehicle/OutputWatchdog.cpp
   src/vehicle/RelativeStateFromOdometry.cpp
+  src/vehicle/RelativeVelocityFilter.cpp
   src/vehicle/Rotation.cpp
   src/vehicle/UnicycleLookAhead.cpp
   src/vehicle/VelocityCommandIntegrator.cpp
