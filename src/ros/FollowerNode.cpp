@@ -14,7 +14,7 @@
 #include "follower/FollowerOptions.hpp"
 #include "follower/FollowerOutputs.hpp"
 #include "follower/FollowerReconfigure.hpp"
-#include "follower/OdometryInput.hpp"
+#include "follower/MeasurementAdapter.hpp"
 
 namespace projection_collision_avoidance {
 
@@ -62,14 +62,15 @@ FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh,
         std::make_unique<FollowerOutputs>(nh, private_nh, name, options, parameters.control_rate,
                                           member, parameters.separation, inputs_.get());
     inputs_->start(nh);
-    if (options.input == MeasurementInput::kOdometry) {
-      odometry_input_ = std::make_unique<OdometryInput>(
-          name, options, parameters.model.double_integrator_axes,
-          [this](const RelativeMeasurement& msg) { inputs_->admitMeasurement(msg); });
+    input_adapter_ = makeMeasurementAdapter(
+        name, options, parameters.model.double_integrator_axes,
+        [this](const RelativeMeasurement& msg) { inputs_->admitMeasurement(msg); });
+    if (input_adapter_) {
+      inputs_->setAdapter(input_adapter_.get());
       outputs_->setMarkerOrigin([this](std::string* frame, Eigen::Vector3d* origin) {
-        return odometry_input_->controlledPoint(frame, origin);
+        return input_adapter_->controlledPoint(frame, origin);
       });
-      odometry_input_->start(nh);
+      input_adapter_->start(nh);
     }
     reconfigure_ = std::make_unique<FollowerReconfigure>(private_nh, name, start, cycle_.get(),
                                                          outputs_.get());
@@ -113,7 +114,10 @@ void FollowerNode::stop() {
     outputs_->stopThread();
   }
   reconfigure_.reset();
-  odometry_input_.reset();
+  if (inputs_) {
+    inputs_->setAdapter(nullptr);
+  }
+  input_adapter_.reset();
   inputs_.reset();  // no measurement's step after this
   outputs_.reset();
 }

@@ -552,7 +552,36 @@ def on_thread(name, key, value):
     return case(name, "~" + key, options={"control_loop": "thread", key: value}, nodes=(FOLLOWER,))
 
 
+def on_input(name, key, source, **options):
+    """A follower on ~input @p source with @p options ("group/key" nested), refused naming
+    @p key."""
+    tree = {"input": source}
+    for path, value in options.items():
+        group, _, leaf = path.rpartition("/")
+        (tree.setdefault(group, {}) if group else tree)[leaf] = value
+    return case(name, "~" + key, options=tree, nodes=(FOLLOWER,))
+
+
 NODE_OPTIONS = [
+    # follower_node: the measurement's source and its adapters' options
+    opt("input unknown", FOLLOWER, "input", "gps"),
+    on_input("odometry twist_frame unknown", "odometry/twist_frame", "odometry",
+             **{"odometry/twist_frame": "map"}),
+    on_input("odometry max_skew < 0", "odometry/max_skew", "odometry",
+             **{"odometry/max_skew": -0.1}),
+    on_input("tf without a world frame", "measurement_frame", "tf",
+             **{"tf/self_frame": "follower", "tf/target_frame": "leader"}),
+    on_input("tf without its own frame", "tf/self_frame", "tf", measurement_frame="world",
+             **{"tf/target_frame": "leader"}),
+    on_input("tf without the target's frame", "tf/target_frame", "tf", measurement_frame="world",
+             **{"tf/self_frame": "follower"}),
+    on_input("tf rate above the control rate", "tf/rate", "tf", measurement_frame="world",
+             **{"tf/self_frame": "follower", "tf/target_frame": "leader", "tf/rate": 1e5}),
+    on_input("position velocity_bandwidth 0", "position/velocity_bandwidth", "position",
+             **{"position/velocity_bandwidth": 0.0}),
+    on_input("position velocity_bandwidth NaN", "position/velocity_bandwidth", "position",
+             **{"position/velocity_bandwidth": NAN}),
+    on_input("position max_gap 0", "position/max_gap", "position", **{"position/max_gap": 0.0}),
     # follower_node
     opt("measurement_timeout < 0", FOLLOWER, "measurement_timeout", -1.0),
     opt("measurement_timeout = 0", FOLLOWER, "measurement_timeout", 0),

@@ -9,7 +9,7 @@ namespace projection_collision_avoidance {
 class FollowerCycle;
 class FollowerInputs;
 class FollowerLoop;
-class OdometryInput;
+class MeasurementAdapter;
 class FollowerOutputs;
 class FollowerReconfigure;
 struct Scenario;
@@ -19,7 +19,7 @@ struct Scenario;
 /// The follower is member ~formation_index of the scenario's formation (layoutFormation()): it
 /// keeps the separation d_i of its slot to its target (the leader, or the follower ahead of it in
 /// a chain). Subscribes `relative_measurement` (RelativeMeasurement, x_target - x_i; with
-/// ~input odometry instead its own `odom` and its target's `target_odom`, OdometryInput) and
+/// ~input odometry, position or tf a MeasurementAdapter makes it; doc/vehicles.md) and
 /// `leader_broadcast` (LeaderBroadcast of the target: monitored always, its acceleration u_1, plus
 /// pinv(B) u_d with controller.leader_information.disturbance, used with ~use_leader_broadcast)
 /// and, with a time headway (controller.spacing.time_headway > 0), `odom` (nav_msgs/Odometry:
@@ -68,10 +68,10 @@ struct Scenario;
 /// (mlockall); the node exits, naming the parameter, if the kernel refuses either.
 ///
 /// The parts, each with one job: FollowerInputs (subscriptions and input guards, writing the
-/// accepted inputs into lock-free slots; OdometryInput with ~input odometry), FollowerCycle (mode,
-/// period accounting, the core's step; no ROS), FollowerLoop (the timer or real-time thread that
-/// ticks the cycle), FollowerOutputs (messages, markers, diagnostics, log lines; a thread of its
-/// own behind a lock-free queue for the real-time loop) and FollowerReconfigure
+/// accepted inputs into lock-free slots; a MeasurementAdapter with another ~input), FollowerCycle
+/// (mode, period accounting, the core's step; no ROS), FollowerLoop (the timer or real-time thread
+/// that ticks the cycle), FollowerOutputs (messages, markers, diagnostics, log lines; a thread of
+/// its own behind a lock-free queue for the real-time loop) and FollowerReconfigure
 /// (dynamic_reconfigure). This class reads the parameters and wires them (doc/layout.md).
 class FollowerNode {
  public:
@@ -88,7 +88,7 @@ class FollowerNode {
 
   std::unique_ptr<FollowerCycle> cycle_;
   std::unique_ptr<FollowerInputs> inputs_;
-  std::unique_ptr<OdometryInput> odometry_input_;  ///< ~input odometry only
+  std::unique_ptr<MeasurementAdapter> input_adapter_;  ///< ~input other than relative_measurement
   std::unique_ptr<FollowerOutputs> outputs_;
   std::unique_ptr<FollowerReconfigure> reconfigure_;
   std::unique_ptr<FollowerLoop> loop_;  ///< started last, stopped first

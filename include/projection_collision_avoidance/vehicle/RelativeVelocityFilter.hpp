@@ -23,10 +23,10 @@ struct VelocityFilterOptions {
 
 /// What became of one relative position.
 enum class VelocityFilterVerdict {
-  kEstimated,     ///< velocity estimated: state valid
-  kStarted,       ///< the first position (or the first after a gap): no velocity yet
-  kNotIncreasing, ///< stamp not after the previous one: ignored
-  kRefused,       ///< a non-finite position or stamp, or a wrong size: ignored
+  kEstimated,      ///< velocity estimated: state valid
+  kStarted,        ///< the first position (or the first after a gap): no velocity yet
+  kNotIncreasing,  ///< stamp not after the previous one: ignored
+  kRefused,        ///< a non-finite position or stamp, or a wrong size: ignored
 };
 
 /// "estimated", "started", "stamp not increasing", "refused".

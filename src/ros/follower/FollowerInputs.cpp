@@ -1,6 +1,7 @@
 #include "follower/FollowerInputs.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <utility>
 
 #include "projection_collision_avoidance/ros/MessageConversions.hpp"
@@ -65,6 +66,11 @@ FollowerInputStats FollowerInputs::stats(std::int64_t now_ns) const {
   stats.rejected_measurements = rejected_measurements_.load(std::memory_order_relaxed);
   stats.rejected_leader_broadcasts = rejected_leader_broadcasts_.load(std::memory_order_relaxed);
   stats.rejected_odometry = rejected_odometry_.load(std::memory_order_relaxed);
+  if (const MeasurementAdapter* adapter = adapter_.load(std::memory_order_acquire)) {
+    stats.rejected_input = adapter->rejected();
+    const double skew = adapter->skew();
+    stats.input_skew = std::isfinite(skew) ? skew : -1.0;
+  }
   const std::lock_guard<std::mutex> lock(reasons_mutex_);
   stats.measurement_rejection = measurement_rejection_;
   stats.leader_rejection = leader_rejection_;

@@ -17,6 +17,7 @@
 #include "projection_collision_avoidance/ros/InputGuard.hpp"
 
 #include "follower/FollowerOptions.hpp"
+#include "follower/MeasurementAdapter.hpp"
 
 namespace projection_collision_avoidance {
 
@@ -31,6 +32,9 @@ struct FollowerInputStats {
   double measurement_age =
       -1.0;                  ///< s, of the last accepted measurement; -1: none on this timeline
   double leader_age = -1.0;  ///< s, of the last accepted leader broadcast; -1: none
+  std::uint64_t rejected_input = 0;  ///< messages the input adapter refused (~input not
+                                     ///< relative_measurement)
+  double input_skew = -1.0;          ///< s, the adapter's latest skew; -1: none
 };
 
 /// The follower's inputs: subscribes `relative_measurement` (with ~input relative_measurement;
@@ -60,6 +64,12 @@ class FollowerInputs {
   /// OdometryInput) and, if accepted, writes it into the cycle (and, with ~trigger measurement,
   /// runs its step). One caller at a time.
   void admitMeasurement(const RelativeMeasurement& msg);
+
+  /// The input adapter whose counts stats() reports (nullptr: none); set before start() and
+  /// cleared before the adapter goes.
+  void setAdapter(const MeasurementAdapter* adapter) {
+    adapter_.store(adapter, std::memory_order_release);
+  }
 
   /// Refusal counts, latest reasons and the inputs' ages at ROS time @p now_ns (any thread).
   FollowerInputStats stats(std::int64_t now_ns) const;
@@ -107,6 +117,7 @@ class FollowerInputs {
   Eigen::VectorXd odometry_state_;
 
   // Read by other threads.
+  std::atomic<const MeasurementAdapter*> adapter_{nullptr};
   std::atomic<std::uint64_t> rejected_measurements_{0};
   std::atomic<std::uint64_t> rejected_leader_broadcasts_{0};
   std::atomic<std::uint64_t> rejected_odometry_{0};

@@ -35,13 +35,15 @@ ControlLoop controlLoopOf(const std::string& value, bool sim_time) {
 
 MeasurementInput inputOf(const std::string& value) {
   for (const MeasurementInput input :
-       {MeasurementInput::kRelativeMeasurement, MeasurementInput::kOdometry}) {
+       {MeasurementInput::kRelativeMeasurement, MeasurementInput::kOdometry,
+        MeasurementInput::kPosition, MeasurementInput::kTf}) {
     if (value == toString(input)) {
       return input;
     }
   }
-  throw ParameterError("~input",
-                       "must be \"relative_measurement\" or \"odometry\", got \"" + value + "\"");
+  throw ParameterError(
+      "~input", "must be \"relative_measurement\", \"odometry\", \"position\" or \"tf\", got \"" +
+                    value + "\"");
 }
 
 OdometryInputOptions readOdometryOptions(NodeOptionReader& reader) {
@@ -61,6 +63,39 @@ OdometryInputOptions readOdometryOptions(NodeOptionReader& reader) {
   o.target_look_ahead =
       reader.number("odometry/target_look_ahead", o.target_look_ahead, 0.0, 1000.0);
   o.tf_timeout = reader.number("odometry/tf_timeout", o.tf_timeout, 0.0, 10.0);
+  return o;
+}
+
+std::string requiredFrame(NodeOptionReader& reader, const std::string& key) {
+  const std::string frame = reader.text(key, "");
+  if (frame.empty()) {
+    throw ParameterError("~" + key, "must name a tf frame with ~input tf");
+  }
+  return frame;
+}
+
+/// ~position/... (and, for the tf input, ~tf/...); @p world_frame is ~measurement_frame.
+PositionInputOptions readPositionOptions(NodeOptionReader& reader, MeasurementInput input,
+                                         const std::string& world_frame, double control_rate,
+                                         double measurement_timeout) {
+  PositionInputOptions o;
+  o.velocity_bandwidth =
+      reader.number("position/velocity_bandwidth", o.velocity_bandwidth, 1e-3, 1e4);
+  o.max_gap = reader.number("position/max_gap", measurement_timeout, 1e-6, 3600.0);
+  o.tf_timeout = reader.number("position/tf_timeout", o.tf_timeout, 0.0, 10.0);
+  if (input != MeasurementInput::kTf) {
+    return o;
+  }
+  if (world_frame.empty()) {
+    throw ParameterError("~measurement_frame",
+                         "must name the world frame in which ~input tf looks the agents up");
+  }
+  o.self_frame = requiredFrame(reader, "tf/self_frame");
+  o.target_frame = requiredFrame(reader, "tf/target_frame");
+  o.rate = reader.number("tf/rate", control_rate, 1e-3, control_rate);
+  o.max_skew = reader.number("tf/max_skew", o.max_skew, 0.0, 3600.0);
+  o.look_ahead = reader.number("tf/look_ahead", o.look_ahead, 0.0, 1000.0);
+  o.target_look_ahead = reader.number("tf/target_look_ahead", o.target_look_ahead, 0.0, 1000.0);
   return o;
 }
 
@@ -115,6 +150,10 @@ FollowerNodeOptions readFollowerOptions(NodeOptionReader& reader, const Controll
   if (options.input == MeasurementInput::kOdometry) {
     options.odometry = readOdometryOptions(reader);
   }
+  if (options.input == MeasurementInput::kPosition || options.input == MeasurementInput::kTf) {
+    options.position = readPositionOptions(reader, options.input, options.measurement_frame,
+                                           p.control_rate, options.measurement_timeout);
+  }
   return options;
 }
 
@@ -126,6 +165,10 @@ const char* toString(MeasurementInput input) {
   switch (input) {
     case MeasurementInput::kOdometry:
       return "odometry";
+    case MeasurementInput::kPosition:
+      return "position";
+    case MeasurementInput::kTf:
+      return "tf";
     case MeasurementInput::kRelativeMeasurement:
     default:
       return "relative_measurement";

@@ -32,9 +32,12 @@ const char* toString(ControlLoop loop);
 enum class MeasurementInput : std::uint8_t {
   kRelativeMeasurement,  ///< "relative_measurement": the package's RelativeMeasurement
   kOdometry,             ///< "odometry": the own `odom` and the target's `target_odom`
+  kPosition,             ///< "position": the target's relative position only (`target_position`,
+                         ///< `target_pose`), the velocity filtered
+  kTf,                   ///< "tf": tf2 lookups of the two agents' frames, the velocity filtered
 };
 
-/// "relative_measurement" or "odometry".
+/// "relative_measurement", "odometry", "position" or "tf".
 const char* toString(MeasurementInput input);
 
 /// The odometry input's options (~odometry/...; doc/vehicles.md).
@@ -45,6 +48,20 @@ struct OdometryInputOptions {
   double look_ahead = 0.0;             ///< m; l of the own controlled point (unicycle), 0: origin
   double target_look_ahead = 0.0;      ///< m; the target's
   double tf_timeout = 0.0;             ///< s a tf lookup of another frame may wait
+};
+
+/// The position and tf inputs' options (~position/... and ~tf/...; doc/vehicles.md).
+struct PositionInputOptions {
+  double velocity_bandwidth = 20.0;  ///< rad/s; ω of the relative velocity filter
+  double max_gap = 0.5;              ///< s; a longer gap between positions restarts the filter
+  double tf_timeout = 0.0;           ///< s a tf lookup of a position's frame may wait
+  // ~input tf only:
+  std::string self_frame;          ///< the follower's body frame (~tf/self_frame)
+  std::string target_frame;        ///< its target's body frame (~tf/target_frame)
+  double rate = 0.0;               ///< Hz of the lookups (default: the control rate)
+  double max_skew = 0.05;          ///< s; largest |t_target − t_self| of the two transforms
+  double look_ahead = 0.0;         ///< m; l of the own controlled point along body x
+  double target_look_ahead = 0.0;  ///< m; the target's
 };
 
 /// Highest ~control_priority (SCHED_FIFO's highest priority on Linux).
@@ -72,6 +89,7 @@ struct FollowerNodeOptions {
   /// ~input: the relative measurement's source (default: the RelativeMeasurement topic).
   MeasurementInput input = MeasurementInput::kRelativeMeasurement;
   OdometryInputOptions odometry;  ///< ~odometry/...: only with input "odometry"
+  PositionInputOptions position;  ///< ~position/..., ~tf/...: only with input "position" or "tf"
   /// ~lock_memory: mlockall(MCL_CURRENT | MCL_FUTURE) at start (default false).
   bool lock_memory = false;
 };

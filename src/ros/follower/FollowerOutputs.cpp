@@ -217,6 +217,9 @@ void FollowerOutputs::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat
   status.add("time_headway (s)", s.time_headway);
   status.add("own_state_fresh", s.own_state_fresh);
   status.add("rejected_odometry", inputs.rejected_odometry);
+  status.add("input", toString(options_.input));
+  status.add("rejected_input_messages", inputs.rejected_input);
+  status.add("input_skew (s)", inputs.input_skew);
   status.add("measurement_age (s)", inputs.measurement_age);
   status.add("leader_age (s)", inputs.leader_age);
   status.add("time_jumps", s.time_jumps);

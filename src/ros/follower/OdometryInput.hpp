@@ -17,6 +17,7 @@
 #include "projection_collision_avoidance/vehicle/RelativeStateFromOdometry.hpp"
 
 #include "follower/FollowerOptions.hpp"
+#include "follower/MeasurementAdapter.hpp"
 
 namespace projection_collision_avoidance {
 
@@ -30,26 +31,26 @@ namespace projection_collision_avoidance {
 /// ~odometry/look_ahead and ~odometry/target_look_ahead ahead of each origin along its body x
 /// axis). The result goes to @p sink as a RelativeMeasurement stamped with the newer stamp, in
 /// the world frame, to be judged like any measurement. Nothing a message carries ends the node.
-class OdometryInput {
+class OdometryInput : public MeasurementAdapter {
  public:
-  using Sink = std::function<void(const RelativeMeasurement&)>;
-
   /// @param axes of the model (2 or 3)
   /// @throws ParameterError naming ~odometry/... (RelativeStateFromOdometry's checks)
   OdometryInput(std::string node_name, const FollowerNodeOptions& options, int axes, Sink sink);
 
   /// Subscribes `odom` and `target_odom` (once the sink's receiver is in place).
-  void start(ros::NodeHandle nh);
+  void start(ros::NodeHandle nh) override;
 
-  /// Odometry messages refused so far (both topics).
-  std::uint64_t rejected() const { return rejected_.load(std::memory_order_relaxed); }
-  /// Pairs of accepted messages refused by the alignment (skew, non-unit quaternion, ...).
-  std::uint64_t rejectedPairs() const { return rejected_pairs_.load(std::memory_order_relaxed); }
+  /// Odometry messages refused so far (both topics), and pairs of accepted messages refused by
+  /// the alignment (skew, non-unit quaternion, no transform, ...).
+  std::uint64_t rejected() const override {
+    return rejected_.load(std::memory_order_relaxed) +
+           rejected_pairs_.load(std::memory_order_relaxed);
+  }
   /// The world frame and the world position (m) of the own controlled point at the latest own
   /// odometry; false before one.
-  bool controlledPoint(std::string* frame, Eigen::Vector3d* point);
+  bool controlledPoint(std::string* frame, Eigen::Vector3d* point) override;
   /// The latest |t_target − t_self| of an aligned pair (s); NaN before one.
-  double skew() const { return skew_.load(std::memory_order_relaxed); }
+  double skew() const override { return skew_.load(std::memory_order_relaxed); }
 
  private:
   /// One agent's side: its guard and latest accepted sample (world frame).

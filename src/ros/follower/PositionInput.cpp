@@ -1,0 +1,227 @@
+#include "follower/PositionInput.hpp"
+
+#include <cmath>
+#include <limits>
+#include <utility>
+
+#include <Eigen/Geometry>
+#include <tf2/exceptions.h>
+#include <tf2_eigen/tf2_eigen.h>
+
+#include "projection_collision_avoidance/core/ParameterError.hpp"
+#include "projection_collision_avoidance/ros/MessageConversions.hpp"
+
+#include "follower/OdometryInput.hpp"
+
+namespace projection_collision_avoidance {
+namespace {
+
+RelativeVelocityFilter makeFilter(const PositionInputOptions& o, int axes) {
+  VelocityFilterOptions f;
+  f.axes = axes;
+  f.bandwidth = o.velocity_bandwidth;
+  f.max_gap = o.max_gap;
+  try {
+    return RelativeVelocityFilter(f);
+  } catch (const std::invalid_argument& error) {
+    throw ParameterError("~position/velocity_bandwidth", error.what());
+  }
+}
+
+Eigen::Vector3d vectorOf(const geometry_msgs::Point& p) { return {p.x, p.y, p.z}; }
+
+}  // namespace
+
+PositionInput::PositionInput(std::string node_name, const FollowerNodeOptions& options, int axes,
+                             Sink sink)
+    : name_(std::move(node_name)),
+      options_(options),
+      axes_(axes),
+      sink_(std::move(sink)),
+      filter_(makeFilter(options.position, axes)),
+      skew_(std::numeric_limits<double>::quiet_NaN()) {
+  const InputGuardLimits limits{"", options.max_future_stamp, options.measurement_timeout};
+  point_guard_ = InputGuard("target_position", limits);
+  pose_guard_ = InputGuard("target_pose", limits);
+  tf_guard_ = InputGuard("tf lookup", limits);
+}
+
+void PositionInput::start(ros::NodeHandle nh) {
+  tf_listener_ = std::make_unique<tf2_ros::TransformListener>(tf_buffer_, nh);
+  if (options_.input == MeasurementInput::kTf) {
+    timer_ =
+        nh.createTimer(ros::Duration(1.0 / options_.position.rate), &PositionInput::onTimer, this);
+    return;
+  }
+  point_subscriber_ = nh.subscribe<geometry_msgs::PointStamped>(
+      "target_position", 10,
+      [this](const geometry_msgs::PointStamped::ConstPtr& msg) {
+        onPosition(&point_guard_, msg->header, vectorOf(msg->point));
+      },
+      ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
+  pose_subscriber_ = nh.subscribe<geometry_msgs::PoseStamped>(
+      "target_pose", 10,
+      [this](const geometry_msgs::PoseStamped::ConstPtr& msg) {
+        onPosition(&pose_guard_, msg->header, vectorOf(msg->pose.position));
+      },
+      ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
+}
+
+bool PositionInput::controlledPoint(std::string* frame, Eigen::Vector3d* point) {
+  const std::lock_guard<std::mutex> lock(point_mutex_);
+  if (!have_point_) {
+    return false;
+  }
+  *frame = options_.measurement_frame;
+  *point = point_;
+  return true;
+}
+
+void PositionInput::onPosition(InputGuard* guard, const std_msgs::Header& header,
+                               const Eigen::Vector3d& p) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  const std::uint64_t before = guard->rejected();
+  admitGuarded(*guard, name_, [&] {
+    const ros::Time now = ros::Time::now();
+    if (clock_.wentBack(now)) {  // every source forgets the old timeline
+      point_guard_.restartTimeline();
+      pose_guard_.restartTimeline();
+      filter_.reset();
+    }
+    if (!checkHeader(*guard, header, now)) {
+      return;
+    }
+    if (!p.allFinite()) {
+      guard->reject(Rejection::kContent, "non-finite position");
+      return;
+    }
+    Eigen::Vector3d world = p;
+    const std::string& world_frame = options_.measurement_frame;
+    if (!world_frame.empty() && header.frame_id != world_frame) {
+      // p is a vector between two points: only the rotation world ← frame acts on it.
+      geometry_msgs::TransformStamped transform;
+      try {
+        transform = tf_buffer_.lookupTransform(world_frame, header.frame_id, header.stamp,
+                                               ros::Duration(options_.position.tf_timeout));
+      } catch (const tf2::TransformException& error) {
+        guard->reject(Rejection::kContent,
+                      "no transform from \"" +
+                          boundedText(header.frame_id, InputGuard::kMaxQuotedLength) + "\" to \"" +
+                          world_frame + "\": " + error.what());
+        return;
+      }
+      world = tf2::transformToEigen(transform).rotation() * p;
+    }
+    std::string why;
+    if (!filter(header.stamp, world_frame.empty() ? header.frame_id : world_frame, world, &why)) {
+      guard->reject(Rejection::kContent, why);
+      return;
+    }
+    guard->accept(nanosecondsOf(header.stamp), nanosecondsOf(now));
+  });
+  rejected_.fetch_add(guard->rejected() - before, std::memory_order_relaxed);
+}
+
+void PositionInput::onTimer(const ros::TimerEvent& /*event*/) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  const std::uint64_t before = tf_guard_.rejected();
+  admitGuarded(tf_guard_, name_, [&] {
+    const ros::Time now = ros::Time::now();
+    if (clock_.wentBack(now)) {
+      tf_guard_.restartTimeline();
+      last_pair_stamp_ = ros::Time();
+      filter_.reset();
+    }
+    const PositionInputOptions& o = options_.position;
+    const std::string& world = options_.measurement_frame;
+    geometry_msgs::TransformStamped self;
+    geometry_msgs::TransformStamped target;
+    if (!tf_buffer_.canTransform(world, o.self_frame, ros::Time()) ||
+        !tf_buffer_.canTransform(world, o.target_frame, ros::Time())) {
+      return;  // not yet (or no longer) both in the tree: nothing to judge
+    }
+    try {
+      self = tf_buffer_.lookupTransform(world, o.self_frame, ros::Time());
+      target = tf_buffer_.lookupTransform(world, o.target_frame, ros::Time());
+    } catch (const tf2::TransformException& error) {
+      tf_guard_.reject(Rejection::kContent, error.what());
+      return;
+    }
+    const ros::Time stamp = std::max(self.header.stamp, target.header.stamp);
+    if (stamp <= last_pair_stamp_) {
+      return;  // nothing new since the last lookup
+    }
+    last_pair_stamp_ = stamp;
+    std_msgs::Header header;
+    header.stamp = stamp;
+    header.frame_id = world;
+    if (!checkHeader(tf_guard_, header, now)) {
+      return;
+    }
+    const double skew = std::abs(secondsBetween(self.header.stamp, target.header.stamp));
+    if (skew > o.max_skew) {
+      tf_guard_.reject(Rejection::kContent, "the transforms' stamps are " + std::to_string(skew) +
+                                                " s apart (> ~tf/max_skew)");
+      return;
+    }
+    const Eigen::Isometry3d world_self = tf2::transformToEigen(self);
+    const Eigen::Isometry3d world_target = tf2::transformToEigen(target);
+    const Eigen::Vector3d self_point = world_self * Eigen::Vector3d(o.look_ahead, 0.0, 0.0);
+    const Eigen::Vector3d target_point =
+        world_target * Eigen::Vector3d(o.target_look_ahead, 0.0, 0.0);
+    {
+      const std::lock_guard<std::mutex> point_lock(point_mutex_);
+      point_ = self_point;
+      have_point_ = self_point.allFinite();
+    }
+    std::string why;
+    if (!filter(stamp, world, target_point - self_point, &why)) {
+      tf_guard_.reject(Rejection::kContent, why);
+      return;
+    }
+    skew_.store(skew, std::memory_order_relaxed);
+    tf_guard_.accept(nanosecondsOf(stamp), nanosecondsOf(now));
+  });
+  rejected_.fetch_add(tf_guard_.rejected() - before, std::memory_order_relaxed);
+}
+
+bool PositionInput::filter(const ros::Time& stamp, const std::string& frame,
+                           const Eigen::Vector3d& p, std::string* why) {
+  const VelocityFilterVerdict verdict = filter_.update(stamp.toSec(), p, &state_);
+  if (verdict == VelocityFilterVerdict::kRefused ||
+      verdict == VelocityFilterVerdict::kNotIncreasing) {
+    *why = std::string("the velocity filter refused the position: ") + toString(verdict);
+    return false;
+  }
+  if (verdict != VelocityFilterVerdict::kEstimated) {
+    return true;  // the first position: no velocity yet
+  }
+  measurement_.header.stamp = stamp;
+  measurement_.header.frame_id = frame;
+  measurement_.position.resize(static_cast<std::size_t>(axes_));
+  measurement_.velocity.resize(static_cast<std::size_t>(axes_));
+  for (int i = 0; i < axes_; ++i) {
+    measurement_.position[static_cast<std::size_t>(i)] = state_(i);
+    measurement_.velocity[static_cast<std::size_t>(i)] = state_(axes_ + i);
+  }
+  sink_(measurement_);
+  return true;
+}
+
+std::unique_ptr<MeasurementAdapter> makeMeasurementAdapter(const std::string& node_name,
+                                                           const FollowerNodeOptions& options,
+                                                           int axes,
+                                                           MeasurementAdapter::Sink sink) {
+  switch (options.input) {
+    case MeasurementInput::kOdometry:
+      return std::make_unique<OdometryInput>(node_name, options, axes, std::move(sink));
+    case MeasurementInput::kPosition:
+    case MeasurementInput::kTf:
+      return std::make_unique<PositionInput>(node_name, options, axes, std::move(sink));
+    case MeasurementInput::kRelativeMeasurement:
+    default:
+      return nullptr;
+  }
+}
+
+}  // namespace projection_collision_avoidance
