@@ -2,11 +2,12 @@
 """rostest: hostile messages at the vehicle adapters' inputs (test/ros/hostile_vehicle_inputs.test).
 
 Sends ~messages random messages to each of /hostile/own_odom and /hostile/target_odom (the
-follower on odometry), /hostile/command and /hostile/adapter_odom (the command adapter) and
+follower on odometry), /hostile/target_position and /hostile/target_pose (a follower on
+positions), /hostile/command and /hostile/adapter_odom (the command adapter) and
 /hostile/cmd_vel, /hostile/cmd_vel_stamped (a unicycle of the plant): stamps 0, now, far ahead,
 far back, the largest ros::Time; frames empty, wrong, 100,000 characters long; values NaN,
 infinite, huge, a zero quaternion. Then every node must answer a ping and do its job with good
-messages: the follower tracks, the adapter converts a command, the plant drives the unicycle.
+messages: the followers track, the adapter converts a command, the plant drives the unicycle.
 Parameters: ~seed, ~messages, ~wall_deadline, ~nodes.
 """
 
@@ -20,7 +21,7 @@ import unittest
 import rosnode
 import rospy
 import rostest
-from geometry_msgs.msg import AccelStamped, Twist, TwistStamped
+from geometry_msgs.msg import AccelStamped, PointStamped, PoseStamped, Twist, TwistStamped
 from nav_msgs.msg import Odometry
 from projection_collision_avoidance.msg import FollowerStatus
 
@@ -38,6 +39,7 @@ class HostileVehicleInputs(unittest.TestCase):
         cls.deadline = rospy.get_param("~wall_deadline")
         cls.lock = threading.Lock()
         cls.statuses = []
+        cls.position_statuses = []
         cls.twists = []
         cls.plant_odometry = []
         pub = lambda topic, kind: rospy.Publisher(topic, kind, queue_size=10000)  # noqa: E731
@@ -47,6 +49,10 @@ class HostileVehicleInputs(unittest.TestCase):
         cls.adapter_odom = pub("/hostile/adapter_odom", Odometry)
         cls.cmd_vel = pub("/hostile/cmd_vel", Twist)
         cls.cmd_vel_stamped = pub("/hostile/cmd_vel_stamped", TwistStamped)
+        cls.target_position = pub("/hostile/target_position", PointStamped)
+        cls.target_pose = pub("/hostile/target_pose", PoseStamped)
+        rospy.Subscriber("/position_follower/status", FollowerStatus,
+                         cls.keep(cls.position_statuses))
         rospy.Subscriber("/follower/status", FollowerStatus, cls.keep(cls.statuses))
         rospy.Subscriber("/adapter/cmd_vel", Twist, cls.keep(cls.twists))
         rospy.Subscriber("/follower/odom", Odometry, cls.keep(cls.plant_odometry))
@@ -85,6 +91,9 @@ class HostileVehicleInputs(unittest.TestCase):
         w.x, w.y, w.z = self.value(), self.value(), self.value()
         return msg
 
+    def point(self, point):
+        point.x, point.y, point.z = self.value(), self.value(), self.value()
+
     def twist(self):
         msg = Twist()
         msg.linear.x, msg.linear.y, msg.angular.z = self.value(), self.value(), self.value()
@@ -99,7 +108,7 @@ class HostileVehicleInputs(unittest.TestCase):
 
     def test_every_node_survives_and_works_after(self):
         publishers = (self.own, self.target, self.command, self.adapter_odom, self.cmd_vel,
-                      self.cmd_vel_stamped)
+                      self.cmd_vel_stamped, self.target_position, self.target_pose)
         for publisher in publishers:
             self.wait_for(lambda p=publisher: p.get_num_connections() > 0, f"{publisher.name}")
         for _ in range(rospy.get_param("~messages")):
@@ -116,6 +125,14 @@ class HostileVehicleInputs(unittest.TestCase):
             stamped.header.stamp, stamped.header.frame_id = self.stamp(), self.frame()
             stamped.twist = self.twist()
             self.cmd_vel_stamped.publish(stamped)
+            position = PointStamped()
+            position.header.stamp, position.header.frame_id = self.stamp(), self.frame()
+            self.point(position.point)
+            self.target_position.publish(position)
+            pose = PoseStamped()
+            pose.header.stamp, pose.header.frame_id = self.stamp(), self.frame()
+            self.point(pose.pose.position)
+            self.target_pose.publish(pose)
             time.sleep(0.002)
         for node in rospy.get_param("~nodes"):
             self.assertTrue(rosnode.rosnode_ping(node, max_count=1, verbose=False),
@@ -130,6 +147,20 @@ class HostileVehicleInputs(unittest.TestCase):
                 return any(s.mode == FollowerStatus.MODE_TRACKING and
                            all(math.isfinite(x) for x in s.command) for s in self.statuses)
         self.wait_for(tracking, "the follower does not track on good odometry")
+        # The follower on positions tracks on good positions: the target 5 m ahead along x.
+        with self.lock:
+            del self.position_statuses[:]
+        def tracking_on_positions():
+            position = PointStamped()
+            position.header.stamp, position.header.frame_id = rospy.Time.now(), "world"
+            position.point.x = 5.0
+            self.target_position.publish(position)
+            time.sleep(0.01)
+            with self.lock:
+                return any(s.mode == FollowerStatus.MODE_TRACKING and
+                           all(math.isfinite(x) for x in s.command) and
+                           abs(s.xi[0]) < 0.5 for s in self.position_statuses)
+        self.wait_for(tracking_on_positions, "the follower does not track on good positions")
         # The adapter turns a good command into a finite (v, omega).
         with self.lock:
             del self.twists[:]
