@@ -679,6 +679,8 @@ NODE_OPTIONS = [
     vehicle("vehicles entry a string", "", "velocity"),
     vehicle("vehicles unknown agent", "", {"kind": "velocity"}, agent="follower_1"),
     vehicle("vehicle kind unknown", "kind", {"kind": "tank"}),
+    vehicle("vehicle odom_frame the world frame", "odom_frame",
+            {"kind": "velocity", "odom_frame": "world"}),
     vehicle("vehicle kind a number", "kind", {"kind": 2}),
     vehicle("unicycle on one axis", "kind", {"kind": "unicycle"}),
     vehicle("vehicle key unknown", "wheel_base", {"kind": "velocity", "wheel_base": 0.3}),

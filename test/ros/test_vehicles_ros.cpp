@@ -10,6 +10,8 @@
 /// Checks: the controlled points never inside the perimeter (every status' distance), ||xi||
 /// within xi_max at every status, the formation converged at the end, no fallback step, and
 /// the axles (from the plant's odometry) never closer than the perimeter less the look-aheads.
+/// Odometry in another frame than `world` (vehicles.launch odom_frames:=true: each follower's
+/// own odom frame) is moved into it with the test's own tf2 lookup.
 
 #include <algorithm>
 #include <array>
@@ -22,6 +24,10 @@
 #include <gtest/gtest.h>
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
+#include <tf2/exceptions.h>
+#include <tf2_eigen/tf2_eigen.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_listener.h>
 
 #include "projection_collision_avoidance/FollowerStatus.h"
 
@@ -58,9 +64,18 @@ class VehiclesTest : public testing::RosTestFixture {
 
   /// Axle positions by stamp; the plant publishes every agent at each tick with one stamp.
   void onOdometry(int agent, const nav_msgs::Odometry& msg) {
+    Eigen::Vector3d p(msg.pose.pose.position.x, msg.pose.pose.position.y, msg.pose.pose.position.z);
+    if (msg.header.frame_id != "world") {
+      try {
+        p = tf2::transformToEigen(
+                tf_buffer_.lookupTransform("world", msg.header.frame_id, ros::Time(0))) *
+            p;
+      } catch (const tf2::TransformException&) {
+        return;  // its static transform not heard yet
+      }
+    }
     const std::lock_guard<std::mutex> lock(mutex_);
-    positions_[msg.header.stamp.toNSec()][agent] = {msg.pose.pose.position.x,
-                                                    msg.pose.pose.position.y};
+    positions_[msg.header.stamp.toNSec()][agent] = {p.x(), p.y()};
   }
 
   /// The agent index of a status' target name ("leader" or "follower_<j>").
@@ -77,6 +92,8 @@ class VehiclesTest : public testing::RosTestFixture {
   std::map<std::uint64_t, std::map<int, std::array<double, 2>>> positions_;
   std::vector<ros::Subscriber> status_subscribers_;
   std::vector<ros::Subscriber> odometry_subscribers_;
+  tf2_ros::Buffer tf_buffer_;
+  tf2_ros::TransformListener tf_listener_{tf_buffer_};
 };
 
 TEST_F(VehiclesTest, TheFormationIsKeptAndNoPerimeterEntered) {

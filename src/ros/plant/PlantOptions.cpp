@@ -63,7 +63,7 @@ VehicleOptions readVehicle(NodeOptionReader& reader, const std::string& agent, i
   }
   std::vector<std::string> allowed{"kind"};
   if (v.kind != VehicleKind::kDoubleIntegrator) {
-    allowed.insert(allowed.end(), {"velocity_lag", "max_speed", "heading"});
+    allowed.insert(allowed.end(), {"velocity_lag", "max_speed", "heading", "odom_frame"});
     allowed.emplace_back(v.kind == VehicleKind::kUnicycle ? "max_yaw_rate" : "twist_frame");
   }
   for (const std::string& key : reader.mapKeys(prefix)) {
@@ -82,6 +82,7 @@ VehicleOptions readVehicle(NodeOptionReader& reader, const std::string& agent, i
   v.velocity_lag = reader.number(prefix + "/velocity_lag", 0.0, 0.0, 1000.0);
   v.max_speed = limitParameter(reader, prefix + "/max_speed");
   v.heading = reader.number(prefix + "/heading", 0.0, -kTwoPi, kTwoPi);
+  v.odom_frame = reader.text(prefix + "/odom_frame", "");
   if (v.kind == VehicleKind::kUnicycle) {
     v.max_yaw_rate = limitParameter(reader, prefix + "/max_yaw_rate");
   } else {
@@ -170,6 +171,13 @@ PlantNodeOptions readPlantOptions(NodeOptionReader& reader, const Scenario& scen
                          "simulated time can wait for the commands");
   }
   o.vehicles = readVehicles(reader, scenario);
+  for (const auto& [agent, vehicle] : o.vehicles) {
+    if (vehicle.odom_frame == o.world_frame) {
+      throw ParameterError(vehicle.key + "/odom_frame",
+                           "must differ from ~world_frame '" + o.world_frame +
+                               "' (leave it unset for odometry in the world frame)");
+    }
+  }
   return o;
 }
 

@@ -29,6 +29,9 @@ struct VehicleOptions {
   double max_yaw_rate = std::numeric_limits<double>::infinity();  ///< rad/s (unicycle); inf: none
   double heading = 0.0;       ///< rad: the unicycle's initial θ, the velocity kind's fixed yaw
   bool twist_in_body = true;  ///< velocity: cmd_vel's linear part in the body frame, else world
+  /// "": odometry in the world frame; else the frame of the vehicle's own odometry, which
+  /// starts at its initial pose as a real base's does (world -> odom_frame broadcast as static)
+  std::string odom_frame;
 };
 
 /// The plant node's own options (besides the scenario), read once from its private namespace.

@@ -35,11 +35,14 @@ PlantVehicle::PlantVehicle(const VehicleOptions& options, Setup setup,
     : kind_(options.kind),
       twist_in_body_(options.twist_in_body),
       setup_(std::move(setup)),
+      odom_frame_(options.odom_frame),
       twist_guard_(setup_.agent_name + "/cmd_vel", InputGuardLimits{}),
       stamped_guard_(setup_.agent_name + "/cmd_vel_stamped", InputGuardLimits{}) {
   const int k = setup_.axes;
   const Eigen::Vector3d p0 = toVector3(initial_state.head(k));
   const Eigen::Vector3d v0 = toVector3(initial_state.tail(k));
+  odom_origin_ = p0;
+  odom_yaw_ = options.heading;
   if (kind_ == VehicleKind::kVelocity) {
     velocity_.emplace(
         k, p0, v0, VelocityLagParameters{options.velocity_lag, options.max_speed, options.heading},
@@ -149,9 +152,25 @@ void PlantVehicle::publishSample(const ros::Time& stamp,
     linear = Eigen::Vector3d(s.v, 0.0, 0.0);
     angular.z() = s.omega;
   }
+  std::string frame = setup_.world_frame;
+  double heading = yaw();
+  if (!odom_frame_.empty()) {  // as a real base counts it: from where and how it started
+    frame = odom_frame_;
+    position = turned(-odom_yaw_, position - odom_origin_);
+    heading -= odom_yaw_;
+  }
   odom_publisher_.publish(
-      toBodyOdometryMsg(position, yaw(), linear, angular, stamp, setup_.world_frame, setup_.frame));
-  transforms->push_back(toTransformMsg(position, yaw(), stamp, setup_.world_frame, setup_.frame));
+      toBodyOdometryMsg(position, heading, linear, angular, stamp, frame, setup_.frame));
+  transforms->push_back(toTransformMsg(position, heading, stamp, frame, setup_.frame));
+}
+
+bool PlantVehicle::odomFrameTransform(const ros::Time& stamp,
+                                      geometry_msgs::TransformStamped* transform) const {
+  if (odom_frame_.empty()) {
+    return false;
+  }
+  *transform = toTransformMsg(odom_origin_, odom_yaw_, stamp, setup_.world_frame, odom_frame_);
+  return true;
 }
 
 void PlantVehicle::advance(double h, const ros::Time& stamp) {

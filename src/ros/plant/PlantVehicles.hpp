@@ -33,7 +33,9 @@ namespace projection_collision_avoidance {
 /// ignored; `unicycle`: linear.x and angular.z, the rest ignored.
 ///
 /// Publishes `<agent>/odom` (REP 105: pose in the world frame with the yaw, twist in the body
-/// frame, the agent's frame as child) and `<agent>/applied_command` (geometry_msgs/TwistStamped:
+/// frame, the agent's frame as child; with an odom_frame, the pose in that frame, which starts at
+/// the vehicle's initial pose as a real base's odometry does, and tf odom_frame -> the agent's
+/// frame) and `<agent>/applied_command` (geometry_msgs/TwistStamped:
 /// the command integrated over each tick, after the timeout and the limits; `velocity`: linear in
 /// the world frame, frame_id the world frame; `unicycle`: linear.x = v, angular.z = ω, frame_id
 /// the agent's).
@@ -60,7 +62,11 @@ class PlantVehicle {
 
   /// [p; v] (2k entries, m and m/s, world): the odometry's origin and its world velocity.
   Eigen::VectorXd state() const;
-  /// Publishes the odometry stamped @p stamp and appends the tf world -> the agent's frame.
+  /// With an odom_frame: the static transform world -> odom_frame (the initial pose), stamped
+  /// @p stamp; false without one.
+  bool odomFrameTransform(const ros::Time& stamp, geometry_msgs::TransformStamped* transform) const;
+  /// Publishes the odometry stamped @p stamp and appends the tf world (or odom_frame) -> the
+  /// agent's frame.
   void publishSample(const ros::Time& stamp,
                      std::vector<geometry_msgs::TransformStamped>* transforms) const;
   /// Integrates @p h (s) with the command held at plant time @p stamp, and publishes it.
@@ -87,7 +93,10 @@ class PlantVehicle {
   Setup setup_;
   std::optional<VelocityLagVehicle> velocity_;
   std::optional<UnicycleVehicle> unicycle_;
-  double z_ = 0.0;  ///< the unicycle's height in 3-D (m)
+  double z_ = 0.0;                                         ///< the unicycle's height in 3-D (m)
+  std::string odom_frame_;                                 ///< "": the world frame
+  Eigen::Vector3d odom_origin_ = Eigen::Vector3d::Zero();  ///< the initial position (world)
+  double odom_yaw_ = 0.0;                                  ///< the initial yaw (rad)
 
   std::mutex* mutex_ = nullptr;
   std::function<ros::Time()> now_;

@@ -162,6 +162,10 @@ void PlantWorld::attachVehicle(Agent* agent) {
 void PlantWorld::connectAgent(Agent* agent) {
   if (agent->vehicle) {
     agent->vehicle->connect(nh_, &mutex_, [this] { return plantNow(); });
+    geometry_msgs::TransformStamped odom_frame;
+    if (agent->vehicle->odomFrameTransform(plantNow(), &odom_frame)) {
+      static_broadcaster_.sendTransform(odom_frame);  // latched: one per vehicle, kept
+    }
     return;
   }
   agent->odom_publisher = nh_.advertise<nav_msgs::Odometry>(agent->name + "/odom", 10);

@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 #include <geometry_msgs/AccelStamped.h>
 #include <ros/ros.h>
+#include <tf2_ros/static_transform_broadcaster.h>
 #include <tf2_ros/transform_broadcaster.h>
 
 #include "projection_collision_avoidance/RelativeMeasurement.h"
@@ -136,6 +137,7 @@ class PlantWorld {
   ros::Publisher clock_publisher_;
   ros::Publisher marker_publisher_;
   tf2_ros::TransformBroadcaster tf_broadcaster_;
+  tf2_ros::StaticTransformBroadcaster static_broadcaster_;  ///< world -> the vehicles' odom frames
   ros::WallTimer shutdown_timer_;
   std::unique_ptr<PlantClock> clock_;  ///< started last
 };
