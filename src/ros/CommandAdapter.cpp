@@ -82,10 +82,7 @@ void CommandAdapter::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
   const std::lock_guard<std::mutex> lock(mutex_);
   admitGuarded(odometry_guard_, name_, [&] {
     const ros::Time now = ros::Time::now();
-    if (odometry_clock_.wentBack(now)) {
-      odometry_guard_.restartTimeline();
-    }
-    if (!checkHeader(odometry_guard_, msg->header, now)) {
+    if (!checkHeaderOnTimeline(odometry_guard_, odometry_clock_, msg->header, now)) {
       return;
     }
     // The heading in the world frame of the commands (tf2 when the odometry's frame differs).

@@ -89,4 +89,14 @@ class ClockWatch {
   std::uint32_t jumps_ = 0;
 };
 
+/// Notes a jump back of ROS time at @p now on @p clock (restarting @p guard's timeline), then
+/// judges @p header (checkHeader()).
+inline bool checkHeaderOnTimeline(InputGuard& guard, ClockWatch& clock,
+                                  const std_msgs::Header& header, const ros::Time& now) {
+  if (clock.wentBack(now)) {
+    guard.restartTimeline();
+  }
+  return checkHeader(guard, header, now);
+}
+
 }  // namespace projection_collision_avoidance

@@ -167,10 +167,7 @@ void FollowerInputs::onLeaderBroadcast(const LeaderBroadcast::ConstPtr& msg) {
 void FollowerInputs::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
   admitGuarded(odometry_guard_, name_, [&] {
     const ros::Time now = ros::Time::now();
-    if (odometry_clock_.wentBack(now)) {
-      odometry_guard_.restartTimeline();
-    }
-    if (!checkHeader(odometry_guard_, msg->header, now)) {
+    if (!checkHeaderOnTimeline(odometry_guard_, odometry_clock_, msg->header, now)) {
       return;
     }
     if (!stateFromOdometryMsg(*msg, axes_, &odometry_state_)) {
