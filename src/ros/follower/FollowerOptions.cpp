@@ -134,6 +134,7 @@ FollowerNodeOptions readFollowerOptions(NodeOptionReader& reader, const Controll
     throw ParameterError("~follower_frame", "must not be empty");
   }
   options.marker_rate = reader.number("marker_rate", options.marker_rate, 0.0, p.control_rate);
+  options.status_rate = reader.number("status_rate", p.control_rate, 0.0, p.control_rate);
   options.trigger = triggerOf(reader.text("trigger", toString(options.trigger)));
   options.control_loop =
       controlLoopOf(reader.text("control_loop", toString(options.control_loop)), sim_time);

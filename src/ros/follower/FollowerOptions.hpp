@@ -78,6 +78,9 @@ struct FollowerNodeOptions {
   std::string odom_frame;              ///< required frame_id of the own odometry ("" = any)
   std::string follower_frame;  ///< frame of the command, status and markers (default: the name)
   double marker_rate = 10.0;   ///< Hz
+  /// Hz of `status` (every round(control_rate / status_rate) steps, and at each change of mode);
+  /// the control rate by default (every step); 0: none
+  double status_rate = 0.0;
   int formation_index = 1;     ///< i: which follower of the scenario's formation this is
   /// ~trigger: "timer" (default) or "measurement"; see FollowerNode.
   ControlTrigger trigger = ControlTrigger::kTimer;

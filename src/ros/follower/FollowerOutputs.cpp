@@ -33,11 +33,13 @@ FollowerOutputs::FollowerOutputs(ros::NodeHandle nh, ros::NodeHandle private_nh,
   marker_publisher_ = nh.advertise<visualization_msgs::MarkerArray>("markers", 2);
   diagnostics_.setHardwareID(options_.follower_frame);
   diagnostics_.add("follower controller", this, &FollowerOutputs::diagnose);
-  // Markers every control_rate / marker_rate steps.
-  if (options_.marker_rate > 0.0) {
-    steps_per_marker_ =
-        static_cast<std::uint64_t>(std::max(1L, std::lround(control_rate / options_.marker_rate)));
-  }
+  // Markers every control_rate / marker_rate steps, statuses every control_rate / status_rate.
+  const auto stepsPer = [control_rate](double rate) -> std::uint64_t {
+    return rate > 0.0 ? static_cast<std::uint64_t>(std::max(1L, std::lround(control_rate / rate)))
+                      : 0;
+  };
+  steps_per_marker_ = stepsPer(options_.marker_rate);
+  steps_per_status_ = stepsPer(options_.status_rate);
 }
 
 FollowerOutputs::~FollowerOutputs() { stopThread(); }
@@ -77,8 +79,13 @@ void FollowerOutputs::publish(const FollowerCycleOutput& out) {
     broadcast.header.frame_id = options_.follower_frame;
     broadcast.input = toStdVector(out.status.command);
     broadcast_publisher_.publish(broadcast);
-    status_publisher_.publish(
-        toStatusMsg(out, inputs_->stats(out.now_ns), member_, options_.follower_frame));
+    // Every so many steps, and at every change of mode (a fallback is never left out).
+    if (steps_per_status_ > 0 &&
+        ((out.steps - 1) % steps_per_status_ == 0 || out.mode != status_mode_)) {
+      status_publisher_.publish(
+          toStatusMsg(out, inputs_->stats(out.now_ns), member_, options_.follower_frame));
+      status_mode_ = out.mode;
+    }
     if (steps_per_marker_ > 0 && (out.steps - 1) % steps_per_marker_ == 0) {
       publishMarkers(out);
     }

@@ -77,6 +77,8 @@ class FollowerOutputs {
   Eigen::VectorXd separation_;
   const FollowerInputs* inputs_;
   std::uint64_t steps_per_marker_ = 0;
+  std::uint64_t steps_per_status_ = 0;  ///< 0: no status
+  FollowerMode status_mode_ = FollowerMode::kWaiting;  ///< the mode of the latest status
   MarkerOrigin marker_origin_;
 
   std::mutex publish_mutex_;    ///< publish(): the timer's or outputs' thread vs a measurement's
