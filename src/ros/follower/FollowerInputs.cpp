@@ -33,13 +33,16 @@ FollowerInputs::FollowerInputs(std::string node_name, const FollowerNodeOptions&
 }
 
 void FollowerInputs::start(ros::NodeHandle nh) {
+  // ~transport udp: UDPROS where the publisher offers it (roscpp does, rospy does not), else TCP.
+  const ros::TransportHints link = options_.transport == Transport::kUdp
+                                       ? ros::TransportHints().unreliable().reliable().tcpNoDelay()
+                                       : ros::TransportHints().tcpNoDelay();
   if (options_.input == MeasurementInput::kRelativeMeasurement) {
     measurement_subscriber_ =
-        nh.subscribe("relative_measurement", 10, &FollowerInputs::onMeasurement, this,
-                     ros::TransportHints().tcpNoDelay());
+        nh.subscribe("relative_measurement", 10, &FollowerInputs::onMeasurement, this, link);
   }
   leader_subscriber_ =
-      nh.subscribe("leader_broadcast", 10, &FollowerInputs::onLeaderBroadcast, this);
+      nh.subscribe("leader_broadcast", 10, &FollowerInputs::onLeaderBroadcast, this, link);
   if (design_.parameters.time_headway > 0.0) {
     odometry_subscriber_ = nh.subscribe("odom", 10, &FollowerInputs::onOdometry, this,
                                         ros::TransportHints().tcpNoDelay());

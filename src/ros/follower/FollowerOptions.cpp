@@ -147,6 +147,11 @@ FollowerNodeOptions readFollowerOptions(NodeOptionReader& reader, const Controll
                              "~control_loop to \"thread\", or this to 0");
   }
   options.lock_memory = reader.boolean("lock_memory", options.lock_memory);
+  const std::string transport = reader.text("transport", toString(options.transport));
+  if (transport != "tcp" && transport != "udp") {
+    throw ParameterError("~transport", "must be \"tcp\" or \"udp\", got \"" + transport + "\"");
+  }
+  options.transport = transport == "udp" ? Transport::kUdp : Transport::kTcp;
   options.input = inputOf(reader.text("input", toString(options.input)));
   if (options.input == MeasurementInput::kOdometry) {
     options.odometry = readOdometryOptions(reader);
@@ -174,6 +179,10 @@ const char* toString(MeasurementInput input) {
     default:
       return "relative_measurement";
   }
+}
+
+const char* toString(Transport transport) {
+  return transport == Transport::kUdp ? "udp" : "tcp";
 }
 
 const char* toString(ControlLoop loop) { return loop == ControlLoop::kThread ? "thread" : "timer"; }

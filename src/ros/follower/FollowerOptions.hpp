@@ -28,6 +28,15 @@ enum class ControlLoop : std::uint8_t {
 /// "timer" or "thread".
 const char* toString(ControlLoop loop);
 
+/// How `relative_measurement` and `leader_broadcast` travel (~transport).
+enum class Transport : std::uint8_t {
+  kTcp,  ///< "tcp": TCPROS with TCP_NODELAY (default)
+  kUdp,  ///< "udp": UDPROS (lost datagrams are not resent), TCPROS where the publisher has none
+};
+
+/// "tcp" or "udp".
+const char* toString(Transport transport);
+
 /// Where the relative measurement comes from (~input).
 enum class MeasurementInput : std::uint8_t {
   kRelativeMeasurement,  ///< "relative_measurement": the package's RelativeMeasurement
@@ -93,6 +102,8 @@ struct FollowerNodeOptions {
   MeasurementInput input = MeasurementInput::kRelativeMeasurement;
   OdometryInputOptions odometry;  ///< ~odometry/...: only with input "odometry"
   PositionInputOptions position;  ///< ~position/..., ~tf/...: only with input "position" or "tf"
+  /// ~transport of relative_measurement and leader_broadcast.
+  Transport transport = Transport::kTcp;
   /// ~lock_memory: mlockall(MCL_CURRENT | MCL_FUTURE) at start (default false).
   bool lock_memory = false;
 };

@@ -232,6 +232,7 @@ void FollowerOutputs::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat
   status.add("time_jumps", s.time_jumps);
   status.add("trigger", toString(options_.trigger));
   status.add("control_loop", toString(options_.control_loop));
+  status.add("transport", toString(options_.transport));
   status.add("control_priority", options_.control_priority);
   status.add("lock_memory", options_.lock_memory);
   status.add("ticks", s.steps);
