@@ -39,8 +39,8 @@ StampCorrection::StampCorrection(const StampCorrectionOptions& options) : option
     throw std::invalid_argument("max_offset must lie in [0, 1e6] s, got " +
                                 std::to_string(options.max_offset));
   }
-  bucket_ns_ = std::max<std::int64_t>(
-      1, std::llround(options.window * kNanosecondsPerSecond / kBuckets));
+  bucket_ns_ =
+      std::max<std::int64_t>(1, std::llround(options.window * kNanosecondsPerSecond / kBuckets));
   max_offset_ns_ = std::llround(options.max_offset * kNanosecondsPerSecond);
 }
 

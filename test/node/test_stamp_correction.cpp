@@ -58,11 +58,11 @@ TEST(StampCorrection, EstimateTakesTheSmallestSkewOfTheWindow) {
 
 TEST(StampCorrection, EstimateForgetsWhatLeftTheWindow) {
   StampCorrection c = correctionOf(ClockPolicy::kEstimate, 1.6);  // buckets of 0.1 s
-  c.accepted(0 * kSecond + 1, 1 * kSecond);  // skew ~1 s
+  c.accepted(0 * kSecond + 1, 1 * kSecond);                       // skew ~1 s
   EXPECT_NEAR(c.minimumSkew(1 * kSecond), 1.0, 1e-6);
-  c.accepted(2 * kSecond - 5 * kSecond, 2 * kSecond);  // skew 5 s, within max_offset
-  EXPECT_NEAR(c.minimumSkew(2 * kSecond), 1.0, 1e-6);  // 1 s ago: still in the window
-  EXPECT_NEAR(c.minimumSkew(2700 * kMs), 5.0, 1e-6);   // 1.7 s later: the first has left it
+  c.accepted(2 * kSecond - 5 * kSecond, 2 * kSecond);   // skew 5 s, within max_offset
+  EXPECT_NEAR(c.minimumSkew(2 * kSecond), 1.0, 1e-6);   // 1 s ago: still in the window
+  EXPECT_NEAR(c.minimumSkew(2700 * kMs), 5.0, 1e-6);    // 1.7 s later: the first has left it
   EXPECT_TRUE(std::isnan(c.minimumSkew(4 * kSecond)));  // both have
 }
 

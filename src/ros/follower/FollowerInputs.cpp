@@ -21,8 +21,10 @@ FollowerInputs::FollowerInputs(std::string node_name, const FollowerNodeOptions&
       measurement_guard_(
           "relative_measurement",
           {options.measurement_frame, options.max_future_stamp, options.measurement_timeout}),
+      measurement_correction_(options.clock_skew),
       leader_guard_("leader_broadcast", {options.leader_broadcast_frame, options.max_future_stamp,
                                          options.leader_timeout}),
+      leader_correction_(options.clock_skew),
       odometry_guard_("odom",
                       {options.odom_frame, options.max_future_stamp, options.measurement_timeout}) {
   measurement_.relative_state.setZero(2 * axes_);
@@ -69,6 +71,9 @@ FollowerInputStats FollowerInputs::stats(std::int64_t now_ns) const {
   stats.rejected_measurements = rejected_measurements_.load(std::memory_order_relaxed);
   stats.rejected_leader_broadcasts = rejected_leader_broadcasts_.load(std::memory_order_relaxed);
   stats.rejected_odometry = rejected_odometry_.load(std::memory_order_relaxed);
+  stats.measurement_skew = measurement_skew_.load(std::memory_order_relaxed);
+  stats.leader_skew = leader_skew_.load(std::memory_order_relaxed);
+  stats.clock_offset = clock_offset_.load(std::memory_order_relaxed);
   if (const MeasurementAdapter* adapter = adapter_.load(std::memory_order_acquire)) {
     stats.rejected_input = adapter->rejected();
     const double skew = adapter->skew();
@@ -81,12 +86,16 @@ FollowerInputStats FollowerInputs::stats(std::int64_t now_ns) const {
 }
 
 bool FollowerInputs::admitHeader(InputGuard& guard, ClockWatch& clock, Heard& heard,
-                                 const std_msgs::Header& header, const ros::Time& now) {
+                                 StampCorrection& correction, const std_msgs::Header& header,
+                                 const ros::Time& now, std::int64_t* offset_ns) {
   if (clock.wentBack(now)) {
     guard.restartTimeline();  // the control cycle notes and reports the jump itself
     heard.effective_ns.store(Heard::kNone, std::memory_order_relaxed);
+    correction.reset();
   }
-  return checkHeader(guard, header, now);
+  const std::int64_t now_ns = nanosecondsOf(now);
+  *offset_ns = correction.offsetFor(nanosecondsOf(header.stamp), now_ns);
+  return guard.checkHeader(header.frame_id, nanosecondsOf(header.stamp), now_ns - *offset_ns);
 }
 
 void FollowerInputs::onMeasurement(const RelativeMeasurement::ConstPtr& msg) {
@@ -97,8 +106,9 @@ void FollowerInputs::admitMeasurement(const RelativeMeasurement& measurement) {
   const RelativeMeasurement* msg = &measurement;
   admitGuarded(measurement_guard_, name_, [&] {
     const ros::Time now = ros::Time::now();
-    if (!admitHeader(measurement_guard_, measurement_clock_, measurement_heard_, msg->header,
-                     now)) {
+    std::int64_t offset = 0;
+    if (!admitHeader(measurement_guard_, measurement_clock_, measurement_heard_,
+                     measurement_correction_, msg->header, now, &offset)) {
       if (measurement_guard_.lastKind() == Rejection::kFuture) {
         cycle_->noteFutureMeasurement();  // this clock may still be catching up after a stall
       }
@@ -109,15 +119,24 @@ void FollowerInputs::admitMeasurement(const RelativeMeasurement& measurement) {
       measurement_guard_.reject(Rejection::kContent, why);
       return;
     }
-    const std::int64_t stamp = nanosecondsOf(msg->header.stamp);
+    const std::int64_t raw = nanosecondsOf(msg->header.stamp);
+    const std::int64_t now_ns = nanosecondsOf(now);
     // Measurement trigger: the periods between this stamp and the last accepted one's.
     const std::uint32_t skipped =
         measurement_guard_.haveAccepted()
-            ? skippedPeriods(1e-9 * static_cast<double>(stamp - measurement_guard_.lastStamp()),
+            ? skippedPeriods(1e-9 * static_cast<double>(raw - measurement_guard_.lastStamp()),
                              design_.period)
             : 0;
-    measurement_guard_.accept(stamp, nanosecondsOf(now));
-    measurement_heard_.note(stamp, nanosecondsOf(now));
+    // On this clock (~clock_skew/policy), never before the previous one.
+    const bool first = !measurement_guard_.haveAccepted();
+    const std::int64_t stamp =
+        first ? raw + offset : std::max(raw + offset, last_corrected_ns_ + 1);
+    last_corrected_ns_ = stamp;
+    measurement_guard_.accept(raw, now_ns - offset);
+    measurement_correction_.accepted(raw, now_ns);
+    measurement_skew_.store(measurement_correction_.lastSkew(), std::memory_order_relaxed);
+    clock_offset_.store(1e-9 * static_cast<double>(offset), std::memory_order_relaxed);
+    measurement_heard_.note(stamp, now_ns);
     measurement_.stamp_ns = stamp;
     measurement_.receipt_ns = nanosecondsOf(now);
     measurement_.sequence = measurement_guard_.accepted();
@@ -141,7 +160,9 @@ void FollowerInputs::admitMeasurement(const RelativeMeasurement& measurement) {
 void FollowerInputs::onLeaderBroadcast(const LeaderBroadcast::ConstPtr& msg) {
   admitGuarded(leader_guard_, name_, [&] {
     const ros::Time now = ros::Time::now();
-    if (!admitHeader(leader_guard_, leader_clock_, leader_heard_, msg->header, now)) {
+    std::int64_t offset = 0;
+    if (!admitHeader(leader_guard_, leader_clock_, leader_heard_, leader_correction_, msg->header,
+                     now, &offset)) {
       return;
     }
     std::string why;
@@ -151,8 +172,11 @@ void FollowerInputs::onLeaderBroadcast(const LeaderBroadcast::ConstPtr& msg) {
       leader_guard_.reject(Rejection::kContent, why);
       return;
     }
-    const std::int64_t stamp = nanosecondsOf(msg->header.stamp);
-    leader_guard_.accept(stamp, nanosecondsOf(now));
+    const std::int64_t raw = nanosecondsOf(msg->header.stamp);
+    const std::int64_t stamp = raw + offset;  // on this clock (~clock_skew/policy)
+    leader_guard_.accept(raw, nanosecondsOf(now) - offset);
+    leader_correction_.accepted(raw, nanosecondsOf(now));
+    leader_skew_.store(leader_correction_.lastSkew(), std::memory_order_relaxed);
     leader_heard_.note(stamp, nanosecondsOf(now));
     leader_.stamp_ns = stamp;
     leader_.receipt_ns = nanosecondsOf(now);

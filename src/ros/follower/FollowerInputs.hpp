@@ -3,6 +3,7 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <mutex>
 #include <string>
 
@@ -13,6 +14,7 @@
 #include "projection_collision_avoidance/RelativeMeasurement.h"
 #include "projection_collision_avoidance/core/ControllerDesign.hpp"
 #include "projection_collision_avoidance/node/FollowerCycle.hpp"
+#include "projection_collision_avoidance/node/StampCorrection.hpp"
 #include "projection_collision_avoidance/ros/InputAdmission.hpp"
 #include "projection_collision_avoidance/ros/InputGuard.hpp"
 
@@ -35,6 +37,10 @@ struct FollowerInputStats {
   std::uint64_t rejected_input = 0;  ///< messages the input adapter refused (~input not
                                      ///< relative_measurement)
   double input_skew = -1.0;          ///< s, the adapter's latest skew; -1: none
+  /// s, receipt − stamp of the latest accepted measurement / leader broadcast; NaN: none
+  double measurement_skew = std::numeric_limits<double>::quiet_NaN();
+  double leader_skew = std::numeric_limits<double>::quiet_NaN();
+  double clock_offset = 0.0;  ///< s, added to the latest accepted measurement's stamp
 };
 
 /// The follower's inputs: subscribes `relative_measurement` (with ~input relative_measurement;
@@ -89,10 +95,13 @@ class FollowerInputs {
     /// Age (s) at @p now_ns; -1 when none, or received after @p now_ns (an older timeline).
     double ageAt(std::int64_t now_ns) const;
   };
-  /// Notes a jump back of ROS time on this input's side (restarting @p guard's timeline and
-  /// forgetting @p heard), then judges @p header at @p now.
+  /// Notes a jump back of ROS time on this input's side (restarting @p guard's timeline,
+  /// forgetting @p heard and what @p correction learnt), then judges @p header at @p now on the
+  /// sender's clock: now − the offset @p correction adds to the stamp (~clock_skew/policy),
+  /// returned in @p offset_ns.
   static bool admitHeader(InputGuard& guard, ClockWatch& clock, Heard& heard,
-                          const std_msgs::Header& header, const ros::Time& now);
+                          StampCorrection& correction, const std_msgs::Header& header,
+                          const ros::Time& now, std::int64_t* offset_ns);
 
   std::string name_;
   FollowerNodeOptions options_;
@@ -105,11 +114,14 @@ class FollowerInputs {
   // Subscriber threads only (one at a time per input: roscpp serialises a subscription).
   InputGuard measurement_guard_;
   ClockWatch measurement_clock_;
+  StampCorrection measurement_correction_;
+  std::int64_t last_corrected_ns_ = 0;  ///< the latest accepted measurement's corrected stamp
   MeasurementSample measurement_;
   Eigen::VectorXd relative_state_;
   FollowerCycleOutput trigger_output_;
   InputGuard leader_guard_;
   ClockWatch leader_clock_;
+  StampCorrection leader_correction_;
   LeaderSample leader_;
   InputGuard odometry_guard_;
   ClockWatch odometry_clock_;
@@ -123,6 +135,9 @@ class FollowerInputs {
   std::atomic<std::uint64_t> rejected_odometry_{0};
   Heard measurement_heard_;
   Heard leader_heard_;
+  std::atomic<double> measurement_skew_{std::numeric_limits<double>::quiet_NaN()};
+  std::atomic<double> leader_skew_{std::numeric_limits<double>::quiet_NaN()};
+  std::atomic<double> clock_offset_{0.0};
   mutable std::mutex reasons_mutex_;
   std::string measurement_rejection_;
   std::string leader_rejection_;

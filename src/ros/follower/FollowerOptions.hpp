@@ -5,6 +5,7 @@
 
 #include "projection_collision_avoidance/core/ControllerParameters.hpp"
 #include "projection_collision_avoidance/core/Formation.hpp"
+#include "projection_collision_avoidance/node/StampCorrection.hpp"
 #include "projection_collision_avoidance/ros/RosParameters.hpp"
 #include "projection_collision_avoidance/sim/Scenario.hpp"
 
@@ -90,7 +91,7 @@ struct FollowerNodeOptions {
   /// Hz of `status` (every round(control_rate / status_rate) steps, and at each change of mode);
   /// the control rate by default (every step); 0: none
   double status_rate = 0.0;
-  int formation_index = 1;     ///< i: which follower of the scenario's formation this is
+  int formation_index = 1;  ///< i: which follower of the scenario's formation this is
   /// ~trigger: "timer" (default) or "measurement"; see FollowerNode.
   ControlTrigger trigger = ControlTrigger::kTimer;
   /// ~control_loop: "timer" (default) or "thread" (wall time only); see FollowerNode.
@@ -102,6 +103,9 @@ struct FollowerNodeOptions {
   MeasurementInput input = MeasurementInput::kRelativeMeasurement;
   OdometryInputOptions odometry;  ///< ~odometry/...: only with input "odometry"
   PositionInputOptions position;  ///< ~position/..., ~tf/...: only with input "position" or "tf"
+  /// ~clock_skew/{policy,window,max_offset}: how the measurements' and broadcasts' stamps are
+  /// put on this clock (doc/multi_host.md).
+  StampCorrectionOptions clock_skew;
   /// ~transport of relative_measurement and leader_broadcast.
   Transport transport = Transport::kTcp;
   /// ~lock_memory: mlockall(MCL_CURRENT | MCL_FUTURE) at start (default false).

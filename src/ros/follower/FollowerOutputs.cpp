@@ -228,6 +228,10 @@ void FollowerOutputs::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat
   status.add("rejected_input_messages", inputs.rejected_input);
   status.add("input_skew (s)", inputs.input_skew);
   status.add("measurement_age (s)", inputs.measurement_age);
+  status.add("measurement_skew (s)", inputs.measurement_skew);
+  status.add("leader_skew (s)", inputs.leader_skew);
+  status.add("clock_offset (s)", inputs.clock_offset);
+  status.add("clock_skew_policy", toString(options_.clock_skew.policy));
   status.add("leader_age (s)", inputs.leader_age);
   status.add("time_jumps", s.time_jumps);
   status.add("trigger", toString(options_.trigger));

@@ -77,7 +77,7 @@ class FollowerOutputs {
   Eigen::VectorXd separation_;
   const FollowerInputs* inputs_;
   std::uint64_t steps_per_marker_ = 0;
-  std::uint64_t steps_per_status_ = 0;  ///< 0: no status
+  std::uint64_t steps_per_status_ = 0;                 ///< 0: no status
   FollowerMode status_mode_ = FollowerMode::kWaiting;  ///< the mode of the latest status
   MarkerOrigin marker_origin_;
 

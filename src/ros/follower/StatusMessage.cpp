@@ -23,6 +23,8 @@ FollowerStatus toStatusMsg(const FollowerCycleOutput& out, const FollowerInputSt
   msg.leader_fresh = out.leader_fresh;
   msg.leader_age = out.leader_age;  // +inf when none on this timeline
   msg.rejected_leader_broadcasts = static_cast<uint32_t>(inputs.rejected_leader_broadcasts);
+  msg.measurement_skew = inputs.measurement_skew;
+  msg.clock_offset = inputs.clock_offset;
   msg.xi = toStdVector(out.xi);
   msg.xi_hat = toStdVector(s.estimate);
   msg.xi_norm = out.xi.norm();
