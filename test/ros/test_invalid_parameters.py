@@ -582,6 +582,16 @@ NODE_OPTIONS = [
     on_input("position velocity_bandwidth NaN", "position/velocity_bandwidth", "position",
              **{"position/velocity_bandwidth": NAN}),
     on_input("position max_gap 0", "position/max_gap", "position", **{"position/max_gap": 0.0}),
+    # follower_node: links and clocks (doc/multi_host.md)
+    opt("transport unknown", FOLLOWER, "transport", "sctp"),
+    opt("status_rate < 0", FOLLOWER, "status_rate", -1.0),
+    opt("status_rate above the control rate", FOLLOWER, "status_rate", 1e6),
+    case("clock_skew policy unknown", "~clock_skew/policy",
+         options={"clock_skew": {"policy": "ntp"}}, nodes=(FOLLOWER,)),
+    case("clock_skew window 0", "~clock_skew/window",
+         options={"clock_skew": {"policy": "estimate", "window": 0.0}}, nodes=(FOLLOWER,)),
+    case("clock_skew max_offset < 0", "~clock_skew/max_offset",
+         options={"clock_skew": {"max_offset": -1.0}}, nodes=(FOLLOWER,)),
     # follower_node
     opt("measurement_timeout < 0", FOLLOWER, "measurement_timeout", -1.0),
     opt("measurement_timeout = 0", FOLLOWER, "measurement_timeout", 0),

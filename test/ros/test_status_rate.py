@@ -36,6 +36,8 @@ class StatusRate(unittest.TestCase):
         n = rospy.get_param("~steps_per_status")
         with self.lock:
             statuses = list(self.statuses)
+        self.assertLess(statuses[0].header.stamp.to_sec(), rospy.get_param("~outage_start"),
+                        "the test joined after the outage began")
         previous = None
         regular = 0
         for status in statuses:
