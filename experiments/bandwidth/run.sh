@@ -7,7 +7,7 @@
 #   --duration  wall seconds counted per setting (default 20; plus ~10 s of start-up)
 #   --rates     control rates (Hz) to measure (default "100 1000")
 #   --port      ROS master port (default 11431)
-set -euo pipefail
+set -eo pipefail
 root=$(cd "$(dirname "$0")/../.." && pwd)
 duration=20
 rates="100 1000"
@@ -37,7 +37,7 @@ for rate in $rates; do
     launch=$!
     out=$(/usr/bin/python3 "$root/experiments/bandwidth/bandwidth.py" --duration "$duration" \
       --label "$label") || { tail -20 "$work/launch.log"; kill "$launch"; exit 1; }
-    if [ $first = 1 ]; then echo "$out"; first=0; else echo "$out" | tail -n +3; fi
+    if [ $first = 1 ]; then echo "$out"; first=0; else echo "$out" | grep -v -e "^| setting" -e "^|---"; fi
     kill -INT "$launch" 2>/dev/null || true
     wait "$launch" 2>/dev/null || true
   done
