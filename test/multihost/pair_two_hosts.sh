@@ -4,7 +4,8 @@
 # pair; each host with its own ROS_IP. FOLLOWER_PREFIX runs the follower under a command (e.g.
 # "faketime -f +2s"). Needs root; without the right to make namespaces it says "skipped: why" and
 # exits 77. Everything it makes is removed on exit, also on failure.
-# Usage: test/multihost/pair_two_hosts.sh BUILD_DIR [extra follower launch args...]
+# Usage: test/multihost/pair_two_hosts.sh BUILD_DIR [launch args for both hosts...]
+#   e.g. sim_time:=false clock_skew_policy:=estimate (with FOLLOWER_PREFIX="faketime -f +2s")
 set -eo pipefail
 build=${1:?build dir}; shift
 tag=pca$$
@@ -51,5 +52,5 @@ done
 scenario=$(rospack find projection_collision_avoidance)/config/scenarios/paper_run2.yaml
 in_follower ${FOLLOWER_PREFIX:-} roslaunch --wait projection_collision_avoidance pair.launch \
   scenario:="$scenario" world:=false control_rate:=100 "$@" >"$log/follower.log" 2>&1 &
-in_world rostest --reuse-master projection_collision_avoidance paper_run2.test follower:=false \
+in_world rostest --reuse-master projection_collision_avoidance paper_run2.test follower:=false "$@" \
   || { tail -30 "$log/follower.log"; exit 1; }
