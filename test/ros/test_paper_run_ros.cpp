@@ -6,6 +6,8 @@
 ///   ~end_time          simulated seconds to observe
 ///   ~tolerance         largest difference to cf_sim of max ||xi|| and min separation (m)
 ///   ~wall_deadline     wall seconds to wait for end_time
+///   ~relative_time     (optional, default false) end_time counts from the first status, not from
+///                      ROS time 0: for runs on wall time (test/multihost)
 
 #include <gtest/gtest.h>
 #include <ros/ros.h>
@@ -31,8 +33,16 @@ TEST_F(FollowerTest, PaperRunThroughTheRosGraph) {
   const SimulationSummary expected = simulate(scenario);
   const ControllerDesign design = ControllerDesign::create(scenario.controller);
 
-  ASSERT_TRUE(waitForStatusTime(end_time, param("wall_deadline")))
-      << "no status at t >= " << end_time << " s; last " << record().last_time << " s";
+  bool relative_time = false;
+  private_nh_.getParam("relative_time", relative_time);
+  double origin = 0.0;
+  if (relative_time) {
+    ASSERT_TRUE(waitFor([this] { return record_.count > 0; }, param("wall_deadline")))
+        << "no status";
+    origin = record().last_time;
+  }
+  ASSERT_TRUE(waitForStatusTime(origin + end_time, param("wall_deadline")))
+      << "no status at t >= " << origin + end_time << " s; last " << record().last_time << " s";
   const testing::StatusRecord r = record();
   ROS_INFO(
       "ROS run: max |xi| %.4f, max |xi_hat| %.4f, min separation %.4f (%d statuses); "
