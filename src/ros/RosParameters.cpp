@@ -286,4 +286,25 @@ void echoScenario(const std::string& node_name, const ros::NodeHandle& private_n
   }
 }
 
+/// ~clock_skew/...: the policy and its window and bound, checked by StampCorrection's rules.
+StampCorrectionOptions readClockSkewOptions(NodeOptionReader& reader) {
+  StampCorrectionOptions o;
+  const std::string policy = reader.text("clock_skew/policy", toString(o.policy));
+  bool known = false;
+  for (const ClockPolicy p :
+       {ClockPolicy::kStamps, ClockPolicy::kReceipt, ClockPolicy::kEstimate}) {
+    if (policy == toString(p)) {
+      o.policy = p;
+      known = true;
+    }
+  }
+  if (!known) {
+    throw ParameterError("~clock_skew/policy",
+                         "must be \"stamps\", \"receipt\" or \"estimate\", got \"" + policy + "\"");
+  }
+  o.window = reader.number("clock_skew/window", o.window, 1e-3, 1e6);
+  o.max_offset = reader.number("clock_skew/max_offset", o.max_offset, 0.0, 1e6);
+  return o;
+}
+
 }  // namespace projection_collision_avoidance

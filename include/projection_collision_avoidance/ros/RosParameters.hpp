@@ -12,6 +12,7 @@
 #include <xmlrpcpp/XmlRpcValue.h>
 #include <yaml-cpp/yaml.h>
 
+#include "projection_collision_avoidance/node/StampCorrection.hpp"
 #include "projection_collision_avoidance/sim/Scenario.hpp"
 
 namespace projection_collision_avoidance {
@@ -81,5 +82,8 @@ class NodeOptionReader {
 /// Logs a scenario's loaded values once (its YAML, one line per entry) under @p node_name.
 void echoScenario(const std::string& node_name, const ros::NodeHandle& private_nh,
                   const std::string& name = "scenario");
+
+/// ~clock_skew/{policy,window,max_offset} (doc/multi_host.md), each refused by its key.
+StampCorrectionOptions readClockSkewOptions(NodeOptionReader& reader);
 
 }  // namespace projection_collision_avoidance

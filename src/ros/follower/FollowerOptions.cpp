@@ -66,27 +66,6 @@ OdometryInputOptions readOdometryOptions(NodeOptionReader& reader) {
   return o;
 }
 
-/// ~clock_skew/...: the policy and its window and bound, checked by StampCorrection's rules.
-StampCorrectionOptions readClockSkew(NodeOptionReader& reader) {
-  StampCorrectionOptions o;
-  const std::string policy = reader.text("clock_skew/policy", toString(o.policy));
-  bool known = false;
-  for (const ClockPolicy p :
-       {ClockPolicy::kStamps, ClockPolicy::kReceipt, ClockPolicy::kEstimate}) {
-    if (policy == toString(p)) {
-      o.policy = p;
-      known = true;
-    }
-  }
-  if (!known) {
-    throw ParameterError("~clock_skew/policy",
-                         "must be \"stamps\", \"receipt\" or \"estimate\", got \"" + policy + "\"");
-  }
-  o.window = reader.number("clock_skew/window", o.window, 1e-3, 1e6);
-  o.max_offset = reader.number("clock_skew/max_offset", o.max_offset, 0.0, 1e6);
-  return o;
-}
-
 std::string requiredFrame(NodeOptionReader& reader, const std::string& key) {
   const std::string frame = reader.text(key, "");
   if (frame.empty()) {
@@ -173,7 +152,7 @@ FollowerNodeOptions readFollowerOptions(NodeOptionReader& reader, const Controll
     throw ParameterError("~transport", "must be \"tcp\" or \"udp\", got \"" + transport + "\"");
   }
   options.transport = transport == "udp" ? Transport::kUdp : Transport::kTcp;
-  options.clock_skew = readClockSkew(reader);
+  options.clock_skew = readClockSkewOptions(reader);
   options.input = inputOf(reader.text("input", toString(options.input)));
   if (options.input == MeasurementInput::kOdometry) {
     options.odometry = readOdometryOptions(reader);

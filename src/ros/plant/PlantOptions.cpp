@@ -155,6 +155,7 @@ PlantNodeOptions readPlantOptions(NodeOptionReader& reader, const Scenario& scen
     throw ParameterError("~command_timeout",
                          "must be > 0, got " + std::to_string(o.command_timeout));
   }
+  o.clock_skew = readClockSkewOptions(reader);
   o.publish_clock = reader.boolean("publish_clock", false);
   o.real_time_factor = reader.number("real_time_factor", 1.0, 0.0, 1000.0);
   if (o.real_time_factor <= 0.0) {

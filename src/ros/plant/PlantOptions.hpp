@@ -42,9 +42,12 @@ struct PlantNodeOptions {
   std::string follower_frame = "follower";  ///< the follower's tf frame
   MeasurementFaults faults;                 ///< ~measurement_*, ~noise_seed
   double command_timeout = 0.5;             ///< s; an older command (by its stamp) counts as zero
-  bool publish_clock = false;               ///< drive the ticks on wall time and publish /clock
-  double real_time_factor = 1.0;            ///< simulated s per wall s with publish_clock
-  double duration = 0.0;                    ///< s of simulated time, then shut down; 0 = forever
+  /// ~clock_skew/...: how the commands' stamps are put on the plant's clock (a follower on
+  /// another host whose clock differs; doc/multi_host.md)
+  StampCorrectionOptions clock_skew;
+  bool publish_clock = false;     ///< drive the ticks on wall time and publish /clock
+  double real_time_factor = 1.0;  ///< simulated s per wall s with publish_clock
+  double duration = 0.0;          ///< s of simulated time, then shut down; 0 = forever
   /// Wall s for which, with publish_clock, simulated time stays at its start until every
   /// follower subscribes its relative_measurement (a large formation loading); 0 = no wait.
   double wait_for_followers = 0.0;

@@ -30,12 +30,14 @@ constexpr double kShutdownDelay = 0.25;
 
 PlantWorld::Agent::Agent(const std::string& agent_name, const std::string& tf_frame,
                          const AgentModel& model, double step, const Eigen::VectorXd& initial_state,
-                         const SignalProfile& disturbance, double command_timeout)
+                         const SignalProfile& disturbance, double command_timeout,
+                         const StampCorrectionOptions& clock_skew)
     : name(agent_name),
       frame(tf_frame),
       integrator(model, step, initial_state, disturbance),
       command(Eigen::VectorXd::Zero(model.inputDimension())),
-      command_guard(agent_name + "/command", {tf_frame, command_timeout, command_timeout}) {}
+      command_guard(agent_name + "/command", {tf_frame, command_timeout, command_timeout}),
+      command_correction(clock_skew) {}
 
 PlantWorld::PlantWorld(ros::NodeHandle nh, ros::NodeHandle private_nh)
     : nh_(nh),
@@ -45,7 +47,8 @@ PlantWorld::PlantWorld(ros::NodeHandle nh, ros::NodeHandle private_nh)
       options_(readPlantOptions(reader_, scenario_)),
       axes_(scenario_.controller.model.double_integrator_axes),
       leader_("leader", options_.leader_frame, scenario_.controller.model, 1.0 / options_.rate,
-              scenario_.leader_initial_state, scenario_.disturbance, options_.command_timeout) {
+              scenario_.leader_initial_state, scenario_.disturbance, options_.command_timeout,
+              options_.clock_skew) {
   echoScenario(name_, private_nh);
   reader_.echo(name_);
 
@@ -63,11 +66,11 @@ PlantWorld::PlantWorld(ros::NodeHandle nh, ros::NodeHandle private_nh)
           scenario_.formation.configured ? "~scenario/formation" : "~follower_frame",
           "follower frame '" + frame + "' clashes with the world or leader frame");
     }
-    followers_.push_back(
-        Follower{Agent(member.name, frame, scenario_.controller.model, 1.0 / options_.rate,
-                       member.initial_state, SignalProfile{}, options_.command_timeout),
-                 member.target,
-                 {}});
+    followers_.push_back(Follower{
+        Agent(member.name, frame, scenario_.controller.model, 1.0 / options_.rate,
+              member.initial_state, SignalProfile{}, options_.command_timeout, options_.clock_skew),
+        member.target,
+        {}});
   }
   attachVehicle(&leader_);
   if (leader_.vehicle &&
@@ -104,6 +107,7 @@ PlantWorld::PlantWorld(ros::NodeHandle nh, ros::NodeHandle private_nh)
     // A restarted /clock: commands of the new timeline are judged afresh.
     const auto restart = [](Agent& agent) {
       agent.command_guard.restartTimeline();
+      agent.command_correction.reset();
       if (agent.vehicle) {
         agent.vehicle->restartTimeline();
       }
@@ -183,7 +187,10 @@ void PlantWorld::onCommand(Agent* agent, const geometry_msgs::AccelStamped::Cons
   // out: its sender's clock is not the plant's (a wall-time stamp under simulated time, say).
   admitGuarded(agent->command_guard, name_, [&] {
     const ros::Time now = plantNow();
-    if (!checkHeader(agent->command_guard, msg->header, now)) {
+    // On the plant's clock (~clock_skew/policy; the stamp as it is by default).
+    const std::int64_t raw = nanosecondsOf(msg->header.stamp);
+    const std::int64_t stamp = raw + agent->command_correction.offsetFor(raw, nanosecondsOf(now));
+    if (!agent->command_guard.checkHeader(msg->header.frame_id, stamp, nanosecondsOf(now))) {
       return;
     }
     std::string why;
@@ -196,7 +203,8 @@ void PlantWorld::onCommand(Agent* agent, const geometry_msgs::AccelStamped::Cons
       ROS_INFO_STREAM(name_ << ": first " << agent->name << "/command received");
     }
     agent->command = command;
-    agent->command_guard.accept(nanosecondsOf(msg->header.stamp), nanosecondsOf(now));
+    agent->command_guard.accept(stamp, nanosecondsOf(now));
+    agent->command_correction.accepted(raw, nanosecondsOf(now));
   });
 }
 

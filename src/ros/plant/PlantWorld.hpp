@@ -66,14 +66,15 @@ class PlantWorld {
   struct Agent {
     Agent(const std::string& agent_name, const std::string& tf_frame, const AgentModel& model,
           double step, const Eigen::VectorXd& initial_state, const SignalProfile& disturbance,
-          double command_timeout);
+          double command_timeout, const StampCorrectionOptions& clock_skew);
 
     std::string name;   ///< topic prefix: "leader", "follower"
     std::string frame;  ///< tf frame; commands must carry it as frame_id
     AgentIntegrator<GenericDimensions> integrator;
     Eigen::VectorXd command;  ///< latest accepted command (m/s^2)
     InputGuard command_guard;
-    bool command_timed_out = false;  ///< the last tick used zero for lack of a fresh command
+    StampCorrection command_correction;  ///< the commands' stamps on the plant's clock
+    bool command_timed_out = false;      ///< the last tick used zero for lack of a fresh command
     ros::Subscriber command_subscriber;
     ros::Publisher odom_publisher;
     ros::Publisher applied_command_publisher;  ///< the command integrated over each tick
