@@ -11,8 +11,6 @@
 #include "projection_collision_avoidance/core/ParameterError.hpp"
 #include "projection_collision_avoidance/ros/MessageConversions.hpp"
 
-#include "follower/OdometryInput.hpp"
-
 namespace projection_collision_avoidance {
 namespace {
 
@@ -206,22 +204,6 @@ bool PositionInput::filter(const ros::Time& stamp, const std::string& frame,
   }
   sink_(measurement_);
   return true;
-}
-
-std::unique_ptr<MeasurementAdapter> makeMeasurementAdapter(const std::string& node_name,
-                                                           const FollowerNodeOptions& options,
-                                                           int axes,
-                                                           MeasurementAdapter::Sink sink) {
-  switch (options.input) {
-    case MeasurementInput::kOdometry:
-      return std::make_unique<OdometryInput>(node_name, options, axes, std::move(sink));
-    case MeasurementInput::kPosition:
-    case MeasurementInput::kTf:
-      return std::make_unique<PositionInput>(node_name, options, axes, std::move(sink));
-    case MeasurementInput::kRelativeMeasurement:
-    default:
-      return nullptr;
-  }
 }
 
 }  // namespace projection_collision_avoidance
