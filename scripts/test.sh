@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Sets up, builds and runs every test; exits non-zero if anything fails.
 #  1. standalone build (cmake + make), all tests (gtest + cross-check with the SciPy reference),
-#     read back with catkin_test_results;
+#     the multi-host cases of test/multihost/run_all.sh (network namespaces, root only), all read
+#     back with catkin_test_results;
 #  2. the everyday ROS routes: the package in a fresh workspace built with catkin_make, catkin build
 #     (catkin-tools) and colcon build, each sourced and used as README says
 #     (scripts/check_workspace.sh);
@@ -21,6 +22,9 @@ make -C "$build_dir" run_tests >"$build_dir/run_tests.log" 2>&1 || {
   echo "test: make run_tests failed (log: $build_dir/run_tests.log)"
   exit 1
 }
+# Hosts of network namespaces (root only; reported as skipped with the reason otherwise).
+echo "== multi-host tests"
+"$root/test/multihost/run_all.sh" "$build_dir" "$build_dir/test_results/projection_collision_avoidance" || true
 results_ok=true
 catkin_test_results --verbose "$build_dir/test_results" || results_ok=false
 # Count test cases from the JUnit files: "passed failed skipped".

@@ -12,10 +12,14 @@
 ///   ~first_out_of_bound  when > 0: the follower expected to be the first outside its xi_max (a
 ///                    chain that is not string stable): those before it stay within it, it does
 ///                    not, and only those before it are held outside their perimeter
+///   ~relative_time   (optional, default false) end_time counts from each follower's first status
+///                    seen, not from time 0: for wall-time runs (test/multihost), where each
+///                    follower's stamps are on its own host's clock
 /// Every follower must report its own place (formation index, target), hear its target's
 /// broadcast, keep ||xi_hat|| within its xi_max, and keep its target outside its perimeter by the
 /// plant's odometry.
 
+#include <cmath>
 #include <cstddef>
 #include <limits>
 #include <map>
@@ -44,6 +48,7 @@ struct AgentRecord {
   std::string name;
   int target = 0;                                  ///< index into the agents (0 the leader)
   testing::StatusRecord status;                    ///< followers only
+  double first_time = std::numeric_limits<double>::quiet_NaN();  ///< s, first status seen
   std::map<ros::Time, Eigen::VectorXd> positions;  ///< odometry positions by stamp
 };
 
@@ -68,18 +73,23 @@ class FormationTest : public testing::RosTestFixture {
             nh_.subscribe<FollowerStatus>("/" + agents_[a].name + "/status", 1000,
                                           [this, a](const FollowerStatus::ConstPtr& msg) {
                                             const std::lock_guard<std::mutex> lock(mutex_);
+                                            if (std::isnan(agents_[a].first_time)) {
+                                              agents_[a].first_time = msg->header.stamp.toSec();
+                                            }
                                             testing::addStatus(*msg, &agents_[a].status);
                                           }));
       }
     }
   }
 
-  /// Spins until every follower has a status stamped at or after @p sim_seconds.
-  bool waitForAll(double sim_seconds, double wall_seconds) {
+  /// Spins until every follower has a status stamped at or after @p sim_seconds (after its first
+  /// status's stamp plus @p sim_seconds when @p relative).
+  bool waitForAll(double sim_seconds, double wall_seconds, bool relative) {
     return waitFor(
-        [this, sim_seconds] {
+        [this, sim_seconds, relative] {
           for (std::size_t a = 1; a < agents_.size(); ++a) {
-            if (agents_[a].status.last_time < sim_seconds) {
+            const double origin = relative ? agents_[a].first_time : 0.0;
+            if (std::isnan(origin) || agents_[a].status.last_time < origin + sim_seconds) {
               return false;
             }
           }
@@ -132,7 +142,9 @@ TEST_F(FormationTest, EveryFollowerHoldsItsSlotAsCfSimDoes) {
   Scenario scenario = scenario_;
   scenario.duration = end_time;
   const FormationSummary expected = simulateFormation(scenario);
-  ASSERT_TRUE(waitForAll(end_time, param("wall_deadline")))
+  bool relative_time = false;
+  private_nh_.getParam("relative_time", relative_time);
+  ASSERT_TRUE(waitForAll(end_time, param("wall_deadline"), relative_time))
       << "not every follower reached t = " << end_time << " s";
   const std::lock_guard<std::mutex> lock(mutex_);
   for (std::size_t i = 0; i < members_.size(); ++i) {
