@@ -187,10 +187,12 @@ void PlantWorld::onCommand(Agent* agent, const geometry_msgs::AccelStamped::Cons
   // out: its sender's clock is not the plant's (a wall-time stamp under simulated time, say).
   admitGuarded(agent->command_guard, name_, [&] {
     const ros::Time now = plantNow();
-    // On the plant's clock (~clock_skew/policy; the stamp as it is by default).
+    // Judged on the sender's clock, its order on the raw stamps and its age against the plant's
+    // time moved by the offset of ~clock_skew/policy (0 by default), as the follower does.
     const std::int64_t raw = nanosecondsOf(msg->header.stamp);
-    const std::int64_t stamp = raw + agent->command_correction.offsetFor(raw, nanosecondsOf(now));
-    if (!agent->command_guard.checkHeader(msg->header.frame_id, stamp, nanosecondsOf(now))) {
+    const std::int64_t now_ns = nanosecondsOf(now);
+    const std::int64_t offset = agent->command_correction.offsetFor(raw, now_ns);
+    if (!agent->command_guard.checkHeader(msg->header.frame_id, raw, now_ns - offset)) {
       return;
     }
     std::string why;
@@ -203,8 +205,12 @@ void PlantWorld::onCommand(Agent* agent, const geometry_msgs::AccelStamped::Cons
       ROS_INFO_STREAM(name_ << ": first " << agent->name << "/command received");
     }
     agent->command = command;
-    agent->command_guard.accept(stamp, nanosecondsOf(now));
-    agent->command_correction.accepted(raw, nanosecondsOf(now));
+    // On the plant's clock, never before the previous one (the estimate's offset may shrink).
+    agent->command_stamp = agent->command_guard.haveAccepted()
+                               ? std::max(raw + offset, agent->command_stamp + 1)
+                               : raw + offset;
+    agent->command_guard.accept(raw, now_ns - offset);
+    agent->command_correction.accepted(raw, now_ns);
   });
 }
 
@@ -269,7 +275,7 @@ bool PlantWorld::commandsAnswer(long k) const {
   const std::int64_t due = nanosecondsOf(clock_->stampOf(k));
   const auto answered = [due](const Agent& agent) {
     return agent.vehicle || !agent.command_guard.haveAccepted() ||
-           agent.command_guard.lastStamp() >= due;
+           agent.command_stamp >= due;
   };
   return answered(leader_) &&
          std::all_of(followers_.begin(), followers_.end(),
@@ -319,7 +325,7 @@ const PlantWorld::Agent& PlantWorld::targetOf(const Follower& follower) const {
 GenericDimensions::InputVector PlantWorld::commandAt(Agent* agent, const ros::Time& now) {
   const InputGuard& guard = agent->command_guard;
   const bool fresh = guard.haveAccepted() &&
-                     std::abs(1e-9 * static_cast<double>(nanosecondsOf(now) - guard.lastStamp())) <=
+                     std::abs(1e-9 * static_cast<double>(nanosecondsOf(now) - agent->command_stamp)) <=
                          options_.command_timeout;
   if (fresh) {
     if (agent->command_timed_out) {
@@ -330,7 +336,7 @@ GenericDimensions::InputVector PlantWorld::commandAt(Agent* agent, const ros::Ti
   }
   if (guard.haveAccepted() && !agent->command_timed_out) {
     ROS_WARN_STREAM(name_ << ": " << agent->name << "/command stamped "
-                          << 1e-9 * static_cast<double>(guard.lastStamp())
+                          << 1e-9 * static_cast<double>(agent->command_stamp)
                           << " s is older than ~command_timeout (" << options_.command_timeout
                           << " s) at " << now.toSec() << " s: using zero");
     agent->command_timed_out = true;

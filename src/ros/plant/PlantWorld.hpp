@@ -74,6 +74,8 @@ class PlantWorld {
     Eigen::VectorXd command;  ///< latest accepted command (m/s^2)
     InputGuard command_guard;
     StampCorrection command_correction;  ///< the commands' stamps on the plant's clock
+    /// ns: the latest accepted command's stamp on the plant's clock (never before the one before)
+    std::int64_t command_stamp = 0;
     bool command_timed_out = false;      ///< the last tick used zero for lack of a fresh command
     ros::Subscriber command_subscriber;
     ros::Publisher odom_publisher;

@@ -1,0 +1,68 @@
+# Hosts made of network namespaces, sourced by test/multihost/hosts.sh and experiments/link/run.sh.
+# make_hosts N: host 0 "world" (10.231.0.1) with a bridge, and hosts 1..N (10.231.0.(1+i)), each
+# joined to the bridge by a veth pair; a master on world (port 11311). on_host I COMMAND... runs a
+# command on host I with its own ROS_IP, the master's URI and ROS_LOG_DIR under $log. The caller
+# sets $log (a directory) and $keep_log (non-empty: keep $log) first. Where namespaces cannot be
+# made, "skipped: why" and exit 77. Everything made is removed on exit, also on failure.
+# shellcheck shell=bash
+
+netns_tag=pca$$
+netns_hosts=()
+
+netns_skip() {
+  echo "skipped: $*"
+  exit 77
+}
+
+netns_cleanup() {
+  for ns in "${netns_hosts[@]}"; do
+    ip netns pids "$ns" 2>/dev/null | xargs -r kill -INT 2>/dev/null || true
+  done
+  sleep 2
+  for ns in "${netns_hosts[@]}"; do
+    ip netns pids "$ns" 2>/dev/null | xargs -r kill -KILL 2>/dev/null || true
+    ip netns del "$ns" 2>/dev/null || true
+  done
+  [[ -n ${keep_log:-} ]] || rm -rf "$log"
+}
+
+host_address() { echo "10.231.0.$((1 + $1))"; }
+
+make_hosts() {
+  local n=$1 world=${netns_tag}h0 i ns
+  [ "$(id -u)" = 0 ] || netns_skip "not root: network namespaces need CAP_SYS_ADMIN"
+  command -v ip >/dev/null || netns_skip "no ip command (iproute2)"
+  trap netns_cleanup EXIT
+  ip netns add "$world" 2>/dev/null || netns_skip "ip netns add refused here"
+  netns_hosts=("$world")
+  ip -n "$world" link set lo up
+  ip -n "$world" link add br0 type bridge 2>/dev/null || netns_skip "no bridge links here"
+  ip -n "$world" addr add "$(host_address 0)/24" dev br0
+  ip -n "$world" link set br0 up
+  for i in $(seq "$n"); do
+    ns=${netns_tag}h$i
+    ip netns add "$ns"
+    netns_hosts+=("$ns")
+    ip link add "${netns_tag}a$i" type veth peer name "${netns_tag}b$i"
+    ip link set "${netns_tag}a$i" netns "$world"
+    ip link set "${netns_tag}b$i" netns "$ns"
+    ip -n "$world" link set "${netns_tag}a$i" master br0 up
+    ip -n "$ns" addr add "$(host_address "$i")/24" dev "${netns_tag}b$i"
+    ip -n "$ns" link set lo up
+    ip -n "$ns" link set "${netns_tag}b$i" up
+  done
+  on_host 0 roscore -p 11311 >"$log/roscore.log" 2>&1 &
+  for _ in $(seq 100); do
+    on_host 0 rosparam list >/dev/null 2>&1 && return 0
+    sleep 0.1
+  done
+  echo "no master on $(host_address 0)" >&2
+  return 1
+}
+
+on_host() {
+  local i=$1
+  shift
+  ip netns exec "${netns_tag}h$i" env ROS_IP="$(host_address "$i")" \
+    ROS_MASTER_URI="http://$(host_address 0):11311" ROS_LOG_DIR="$log/ros" "$@"
+}
