@@ -4,14 +4,13 @@
 /// counts them. Each runs for ~duration s, then logs "link_flood: <mode> <count> messages, <rate>
 /// Hz" and exits 0 (2: bad parameters).
 
-#include <time.h>
-
 #include <atomic>
 #include <cstdint>
 #include <string>
 
 #include <ros/ros.h>
 #include <std_msgs/UInt8MultiArray.h>
+#include <time.h>
 
 namespace {
 

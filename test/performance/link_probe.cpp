@@ -3,13 +3,17 @@
 ///
 /// Parameters:
 ///   ~transport  tcp or udp (ros::TransportHints().unreliable().reliable() as the follower does)
-///   ~warmup     s before the window opens (default 3)
+///   ~start      s of ROS time (wall time: since the epoch) at which the window opens, so that
+///   probes
+///               on several hosts count the same measurements; 0 (default): ~warmup s from now
+///   ~warmup     s before the window opens when ~start is 0 (default 3)
 ///   ~duration   s of the window (default 20)
 ///   ~output     file: one line per measurement stamped in the window, "stamp_ns receipt_ns",
 ///               receipt the time roscpp read the message off its socket
 ///               (ros::MessageEvent::getReceiptTime()), both on this host's ROS clock
 /// After the window and a drain of 1 s it writes ~output and exits 0 (2: bad parameters).
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <mutex>
@@ -37,8 +41,7 @@ class LinkProbe {
   }
 
   /// Measurements stamped in [start, end), as (stamp, receipt) in ns.
-  std::vector<std::pair<std::int64_t, std::int64_t>> window(std::int64_t start,
-                                                            std::int64_t end) {
+  std::vector<std::pair<std::int64_t, std::int64_t>> window(std::int64_t start, std::int64_t end) {
     const std::lock_guard<std::mutex> lock(mutex_);
     std::vector<std::pair<std::int64_t, std::int64_t>> in;
     for (const auto& a : arrivals_) {
@@ -74,9 +77,10 @@ int main(int argc, char** argv) {
   const double warmup = pnh.param("warmup", 3.0);
   const double duration = pnh.param("duration", 20.0);
   const std::string output = pnh.param<std::string>("output", "");
+  const double start_s = pnh.param("start", 0.0);
   if ((transport != "tcp" && transport != "udp") || output.empty() || !(duration > 0.0) ||
-      !(warmup >= 0.0)) {
-    ROS_FATAL("link_probe: ~transport tcp|udp, ~output, ~duration > 0 and ~warmup >= 0 needed");
+      !(warmup >= 0.0) || !(start_s >= 0.0)) {
+    ROS_FATAL("link_probe: ~transport tcp|udp, ~output, ~duration > 0, ~warmup >= 0, ~start >= 0");
     return 2;
   }
   const ros::TransportHints hints = transport == "udp"
@@ -86,10 +90,11 @@ int main(int argc, char** argv) {
   ros::AsyncSpinner spinner(1);
   spinner.start();
   const ros::WallTime begin = ros::WallTime::now();
-  const std::int64_t start = static_cast<std::int64_t>(ros::Time::now().toNSec()) +
-                             static_cast<std::int64_t>(warmup * 1e9);
+  const auto now_ns = static_cast<std::int64_t>(ros::Time::now().toNSec());
+  const std::int64_t start = start_s > 0.0 ? static_cast<std::int64_t>(start_s * 1e9)
+                                           : now_ns + static_cast<std::int64_t>(warmup * 1e9);
   const std::int64_t end = start + static_cast<std::int64_t>(duration * 1e9);
-  ros::WallDuration(warmup + duration + 1.0).sleep();
+  ros::WallDuration(std::max(0.0, 1e-9 * static_cast<double>(end - now_ns)) + 1.0).sleep();
   spinner.stop();
   const auto in = probe.window(start, end);
   std::FILE* file = std::fopen(output.c_str(), "w");

@@ -46,10 +46,10 @@ namespace {
 /// What the test saw of one agent.
 struct AgentRecord {
   std::string name;
-  int target = 0;                                  ///< index into the agents (0 the leader)
-  testing::StatusRecord status;                    ///< followers only
+  int target = 0;                ///< index into the agents (0 the leader)
+  testing::StatusRecord status;  ///< followers only
   double first_time = std::numeric_limits<double>::quiet_NaN();  ///< s, first status seen
-  std::map<ros::Time, Eigen::VectorXd> positions;  ///< odometry positions by stamp
+  std::map<ros::Time, Eigen::VectorXd> positions;                ///< odometry positions by stamp
 };
 
 class FormationTest : public testing::RosTestFixture {

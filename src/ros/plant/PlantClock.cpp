@@ -148,16 +148,16 @@ void PlantClock::onWallTick(const ros::WallTimerEvent& /*event*/) {
   }
 }
 
-void PlantClock::onRosTick(const ros::TimerEvent& /*event*/) {
+void PlantClock::onRosTick(const ros::TimerEvent& event) {
   const std::lock_guard<std::mutex> lock(*mutex_);
   try {
-    rosTick();
+    rosTick(event.current_expected);
   } catch (const std::exception& error) {
     ROS_ERROR_STREAM_THROTTLE(5.0, name_ << ": tick failed: " << error.what());
   }
 }
 
-void PlantClock::rosTick() {
+void PlantClock::rosTick(const ros::Time& expected) {
   const ros::Time now = ros::Time::now();
   if (!running_ || now.isZero()) {
     return;
@@ -171,9 +171,16 @@ void PlantClock::rosTick() {
   if (!started_) {
     // Under use_sim_time scenario time is ROS time; otherwise it starts at the first tick.
     started_ = true;
-    origin_ = ros::Time::isSimTime() ? ros::Time(0) : now;
-    next_tick_ =
-        static_cast<long>(std::ceil(secondsBetween(now, origin_) * options_.rate - kTickTolerance));
+    // On wall time the ticks are counted from when the timer was due, not from when its first
+    // callback ran: the later callbacks, each a little after its own due time, then never floor
+    // to the tick before (which would publish every sample a period late).
+    origin_ = ros::Time::isSimTime()                    ? ros::Time(0)
+              : (!expected.isZero() && expected <= now) ? expected
+                                                        : now;
+    next_tick_ = ros::Time::isSimTime()
+                     ? static_cast<long>(
+                           std::ceil(secondsBetween(now, origin_) * options_.rate - kTickTolerance))
+                     : 0;
     if (last_tick_ >= 0 && next_tick_ > last_tick_) {
       std::ostringstream why;
       why << "ROS time " << now.toSec() << " s is already past ~duration = " << options_.duration

@@ -60,7 +60,8 @@ class PlantClock {
  private:
   void onWallTick(const ros::WallTimerEvent& event);
   void onRosTick(const ros::TimerEvent& event);
-  void rosTick();
+  /// @param expected when the timer was due (its TimerEvent's current_expected)
+  void rosTick(const ros::Time& expected);
   /// Runs the ticks from next_tick_ through @p due while the plant runs (and, in lockstep, the
   /// commands answer), at wall time @p wall_now.
   void runThrough(long due, const ros::WallTime& wall_now);

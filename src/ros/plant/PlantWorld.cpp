@@ -274,8 +274,7 @@ void PlantWorld::advanceAll(long k) {
 bool PlantWorld::commandsAnswer(long k) const {
   const std::int64_t due = nanosecondsOf(clock_->stampOf(k));
   const auto answered = [due](const Agent& agent) {
-    return agent.vehicle || !agent.command_guard.haveAccepted() ||
-           agent.command_stamp >= due;
+    return agent.vehicle || !agent.command_guard.haveAccepted() || agent.command_stamp >= due;
   };
   return answered(leader_) &&
          std::all_of(followers_.begin(), followers_.end(),
@@ -324,9 +323,10 @@ const PlantWorld::Agent& PlantWorld::targetOf(const Follower& follower) const {
 
 GenericDimensions::InputVector PlantWorld::commandAt(Agent* agent, const ros::Time& now) {
   const InputGuard& guard = agent->command_guard;
-  const bool fresh = guard.haveAccepted() &&
-                     std::abs(1e-9 * static_cast<double>(nanosecondsOf(now) - agent->command_stamp)) <=
-                         options_.command_timeout;
+  const bool fresh =
+      guard.haveAccepted() &&
+      std::abs(1e-9 * static_cast<double>(nanosecondsOf(now) - agent->command_stamp)) <=
+          options_.command_timeout;
   if (fresh) {
     if (agent->command_timed_out) {
       ROS_INFO_STREAM(name_ << ": " << agent->name << "/command fresh again");

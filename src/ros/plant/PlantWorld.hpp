@@ -76,7 +76,7 @@ class PlantWorld {
     StampCorrection command_correction;  ///< the commands' stamps on the plant's clock
     /// ns: the latest accepted command's stamp on the plant's clock (never before the one before)
     std::int64_t command_stamp = 0;
-    bool command_timed_out = false;      ///< the last tick used zero for lack of a fresh command
+    bool command_timed_out = false;  ///< the last tick used zero for lack of a fresh command
     ros::Subscriber command_subscriber;
     ros::Publisher odom_publisher;
     ros::Publisher applied_command_publisher;  ///< the command integrated over each tick
