@@ -8,6 +8,7 @@
 
 netns_tag=pca$$
 netns_hosts=()
+netns_made_mount=""
 
 netns_skip() {
   echo "skipped: $*"
@@ -23,6 +24,10 @@ netns_cleanup() {
     ip netns pids "$ns" 2>/dev/null | xargs -r kill -KILL 2>/dev/null || true
     ip netns del "$ns" 2>/dev/null || true
   done
+  # `ip netns add` made /run/netns a mount point of itself when it was none: undo that too.
+  if [[ -n $netns_made_mount ]] && [[ -z $(ip netns list 2>/dev/null) ]]; then
+    umount /run/netns 2>/dev/null || true
+  fi
   [[ -n ${keep_log:-} ]] || rm -rf "$log"
 }
 
@@ -32,6 +37,9 @@ make_hosts() {
   local n=$1 world=${netns_tag}h0 i ns
   [ "$(id -u)" = 0 ] || netns_skip "not root: network namespaces need CAP_SYS_ADMIN"
   command -v ip >/dev/null || netns_skip "no ip command (iproute2)"
+  command -v nsenter >/dev/null || netns_skip "no nsenter command (util-linux)"
+  netns_made_mount=""
+  mountpoint -q /run/netns 2>/dev/null || netns_made_mount=yes
   trap netns_cleanup EXIT
   ip netns add "$world" 2>/dev/null || netns_skip "ip netns add refused here"
   netns_hosts=("$world")
@@ -60,9 +68,11 @@ make_hosts() {
   return 1
 }
 
+# nsenter enters the network namespace alone: `ip netns exec` also remounts / and /sys in a
+# mount namespace of its own, which a chroot (CI's fresh root) refuses.
 on_host() {
   local i=$1
   shift
-  ip netns exec "${netns_tag}h$i" env ROS_IP="$(host_address "$i")" \
+  nsenter --net="/run/netns/${netns_tag}h$i" env ROS_IP="$(host_address "$i")" \
     ROS_MASTER_URI="http://$(host_address 0):11311" ROS_LOG_DIR="$log/ros" "$@"
 }

@@ -25,9 +25,9 @@ declare -A cases=(
   [formation_sim_time]="formation"
   [formation_skewed_estimate]="formation --clocks +1.5s,-0.7s,+0.04s ${wall[*]} ${estimate[*]}"
 )
-order=(pair_sim_time pair_udp pair_ahead_30ms_stamps pair_behind_30ms_stamps
-  pair_ahead_2s_estimate pair_behind_2s_estimate pair_ahead_2s_receipt
-  pair_ahead_2s_stamps_refused formation_sim_time formation_skewed_estimate)
+order=(pair_sim_time pair_udp pair_ahead_30ms_stamps pair_behind_30ms_stamps)
+order+=(pair_ahead_2s_estimate pair_behind_2s_estimate pair_ahead_2s_receipt)
+order+=(pair_ahead_2s_stamps_refused formation_sim_time formation_skewed_estimate)
 [[ $# -gt 0 ]] && order=("$@")
 
 mkdir -p "$results"
