@@ -31,6 +31,13 @@ netns_cleanup() {
   [[ -n ${keep_log:-} ]] || rm -rf "$log"
 }
 
+# `ip` inside a namespace (not `ip -n`, which remounts / as `ip netns exec` does).
+netns_ip() {
+  local ns=$1
+  shift
+  nsenter --net="/run/netns/$ns" ip "$@"
+}
+
 host_address() { echo "10.231.0.$((1 + $1))"; }
 
 make_hosts() {
@@ -43,10 +50,10 @@ make_hosts() {
   trap netns_cleanup EXIT
   ip netns add "$world" 2>/dev/null || netns_skip "ip netns add refused here"
   netns_hosts=("$world")
-  ip -n "$world" link set lo up
-  ip -n "$world" link add br0 type bridge 2>/dev/null || netns_skip "no bridge links here"
-  ip -n "$world" addr add "$(host_address 0)/24" dev br0
-  ip -n "$world" link set br0 up
+  netns_ip "$world" link set lo up
+  netns_ip "$world" link add br0 type bridge 2>/dev/null || netns_skip "no bridge links here"
+  netns_ip "$world" addr add "$(host_address 0)/24" dev br0
+  netns_ip "$world" link set br0 up
   for i in $(seq "$n"); do
     ns=${netns_tag}h$i
     ip netns add "$ns"
@@ -54,10 +61,10 @@ make_hosts() {
     ip link add "${netns_tag}a$i" type veth peer name "${netns_tag}b$i"
     ip link set "${netns_tag}a$i" netns "$world"
     ip link set "${netns_tag}b$i" netns "$ns"
-    ip -n "$world" link set "${netns_tag}a$i" master br0 up
-    ip -n "$ns" addr add "$(host_address "$i")/24" dev "${netns_tag}b$i"
-    ip -n "$ns" link set lo up
-    ip -n "$ns" link set "${netns_tag}b$i" up
+    netns_ip "$world" link set "${netns_tag}a$i" master br0 up
+    netns_ip "$ns" addr add "$(host_address "$i")/24" dev "${netns_tag}b$i"
+    netns_ip "$ns" link set lo up
+    netns_ip "$ns" link set "${netns_tag}b$i" up
   done
   on_host 0 roscore -p 11311 >"$log/roscore.log" 2>&1 &
   for _ in $(seq 100); do
