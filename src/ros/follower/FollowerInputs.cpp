@@ -34,7 +34,11 @@ FollowerInputs::FollowerInputs(std::string node_name, const FollowerNodeOptions&
   odometry_state_ = Eigen::VectorXd::Zero(2 * axes_);
 }
 
-void FollowerInputs::start(ros::NodeHandle nh) {
+void FollowerInputs::start(ros::NodeHandle node) {
+  // Each callback only judges a message and writes it into a lock-free slot: it runs on the
+  // thread that read the message (InlineCallbackQueue), with no wake-up of a spinner.
+  ros::NodeHandle nh(node);
+  nh.setCallbackQueue(&inline_queue_);
   // ~transport udp: UDPROS where the publisher offers it (roscpp does, rospy does not), else TCP.
   const ros::TransportHints link = options_.transport == Transport::kUdp
                                        ? ros::TransportHints().unreliable().reliable().tcpNoDelay()

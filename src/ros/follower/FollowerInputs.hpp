@@ -15,6 +15,7 @@
 #include "projection_collision_avoidance/core/ControllerDesign.hpp"
 #include "projection_collision_avoidance/node/FollowerCycle.hpp"
 #include "projection_collision_avoidance/node/StampCorrection.hpp"
+#include "projection_collision_avoidance/ros/InlineCallbackQueue.hpp"
 #include "projection_collision_avoidance/ros/InputAdmission.hpp"
 #include "projection_collision_avoidance/ros/InputGuard.hpp"
 
@@ -142,6 +143,8 @@ class FollowerInputs {
   std::string measurement_rejection_;
   std::string leader_rejection_;
 
+  /// The subscriptions' callbacks run at once on roscpp's network thread (no spinner hand-off).
+  InlineCallbackQueue inline_queue_;
   ros::Subscriber measurement_subscriber_;
   ros::Subscriber leader_subscriber_;
   ros::Subscriber odometry_subscriber_;  ///< only with a time headway (S1)

@@ -74,19 +74,25 @@ void FollowerOutputs::publish(const FollowerCycleOutput& out) {
   if (out.stepped) {
     const ros::Time stamp = rosTimeOf(out.stamp_ns);
     command_publisher_.publish(toAccelMsg(out.status.command, stamp, options_.follower_frame));
-    LeaderBroadcast broadcast;  // for a follower behind this one: its acceleration, no state
-    broadcast.header.stamp = stamp;
-    broadcast.header.frame_id = options_.follower_frame;
-    broadcast.input = toStdVector(out.status.command);
-    broadcast_publisher_.publish(broadcast);
+    // The other messages are made only while someone subscribes to them.
+    if (broadcast_publisher_.getNumSubscribers() > 0) {
+      LeaderBroadcast broadcast;  // for a follower behind this one: its acceleration, no state
+      broadcast.header.stamp = stamp;
+      broadcast.header.frame_id = options_.follower_frame;
+      broadcast.input = toStdVector(out.status.command);
+      broadcast_publisher_.publish(broadcast);
+    }
     // Every so many steps, and at every change of mode (a fallback is never left out).
     if (steps_per_status_ > 0 &&
         ((out.steps - 1) % steps_per_status_ == 0 || out.mode != status_mode_)) {
-      status_publisher_.publish(
-          toStatusMsg(out, inputs_->stats(out.now_ns), member_, options_.follower_frame));
+      if (status_publisher_.getNumSubscribers() > 0) {
+        status_publisher_.publish(
+            toStatusMsg(out, inputs_->stats(out.now_ns), member_, options_.follower_frame));
+      }
       status_mode_ = out.mode;
     }
-    if (steps_per_marker_ > 0 && (out.steps - 1) % steps_per_marker_ == 0) {
+    if (steps_per_marker_ > 0 && (out.steps - 1) % steps_per_marker_ == 0 &&
+        marker_publisher_.getNumSubscribers() > 0) {
       publishMarkers(out);
     }
   }
