@@ -8,7 +8,8 @@ wall seconds, two ways:
 The follower's ticks over the window come from its diagnostics ("ticks"), which it publishes
 anyway (1 Hz), so that the measurement adds no subscriber to the topics it times.
 
-  node_cpu.py --rates 100 1000 --window 30 --json OUT.jsonl [--port 11431] [--launch-arg k:=v ...]
+  node_cpu.py --rates 100 1000 --window 30 --json OUT.jsonl [--label L] [--launch-arg k:=v ...]
+  node_cpu.py --report --json OUT.jsonl --csv OUT.csv     (the table of every measurement)
 
 Prints one line per rate and node; writes one JSON line per rate to OUT.jsonl.
 """
@@ -141,7 +142,7 @@ def measure(args, rate):
     (s0, k0), (s1, k1) = before[-1], after[0]
     tick_rate = (k1 - k0) / (s1 - s0)
     window = t1 - t0
-    result = {"rate": rate, "window_s": window, "tick_rate": tick_rate, "nodes": {},
+    result = {"label": args.label, "rate": rate, "window_s": window, "tick_rate": tick_rate, "nodes": {},
               "launch_args": args.launch_arg}
     hz = os.sysconf("SC_CLK_TCK")
     for node in pids:
@@ -164,17 +165,46 @@ def measure(args, rate):
     return result
 
 
+def report(args):
+    """The CSV of every measurement in --json, and the same as a Markdown table on stdout."""
+    rows = []
+    with open(args.json) as f:
+        for line in f:
+            r = json.loads(line)
+            for node, n in sorted(r["nodes"].items()):
+                rows.append([r.get("label", ""), "%g" % r["rate"], node,
+                             "%.2f" % n["percent_core_sched"], "%.2f" % n["percent_core_stat"],
+                             "%.1f" % n["us_per_tick_sched"], "%.1f" % n["us_per_tick_stat"],
+                             "%.2f" % r["tick_rate"], "%.1f" % r["window_s"]])
+    header = ["build", "control rate (Hz)", "node", "% of a core (schedstat)", "% of a core (stat)",
+              "us per tick (schedstat)", "us per tick (stat)", "follower ticks (Hz)", "window (s)"]
+    with open(args.csv, "w") as out:
+        out.write(",".join(header) + "\n")
+        for row in rows:
+            out.write(",".join(row) + "\n")
+    print("| " + " | ".join(header) + " |")
+    print("|" + "---|" * len(header))
+    for row in rows:
+        print("| " + " | ".join(row) + " |")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--rates", type=float, nargs="+", default=[100.0, 1000.0])
     parser.add_argument("--window", type=float, default=30.0, help="wall seconds measured")
     parser.add_argument("--settle", type=float, default=3.0, help="s after the first ticks")
     parser.add_argument("--port", type=int, default=11431)
-    parser.add_argument("--json", required=True, help="results, one JSON line per rate")
+    parser.add_argument("--json", required=True, help="results, one JSON line per rate (appended)")
+    parser.add_argument("--label", default="", help="name of the build measured")
+    parser.add_argument("--report", action="store_true", help="only write --csv from --json")
+    parser.add_argument("--csv", help="with --report: the table as CSV")
     parser.add_argument("--work", default="/tmp", help="directory of the ticks logs")
     parser.add_argument("--launch-arg", action="append", default=[],
                         help="extra pair.launch argument k:=v (repeatable)")
     args = parser.parse_args()
+    if args.report:
+        report(args)
+        return
     signal.signal(signal.SIGTERM, signal.default_int_handler)
     with open(args.json, "a") as out:
         for rate in args.rates:
