@@ -77,8 +77,10 @@ FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh,
     if (options.control_loop == ControlLoop::kThread) {
       outputs_->startThread([this] { reconfigure_->collectRetired(); });
     }
-    loop_ = std::make_unique<FollowerLoop>(nh, name, options, parameters.control_rate, cycle_.get(),
-                                           outputs_.get());
+    // "tick" and the formation index: each follower's tick thread by name, even in one manager.
+    loop_ =
+        std::make_unique<FollowerLoop>(nh, name, "tick " + std::to_string(member.index), options,
+                                       parameters.control_rate, cycle_.get(), outputs_.get());
   } catch (...) {
     stop();  // the parts already running, in the order the destructor stops them
     throw;

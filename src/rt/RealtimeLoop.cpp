@@ -16,7 +16,8 @@ namespace projection_collision_avoidance {
 namespace {
 
 constexpr std::int64_t kNanosecondsPerSecond = 1000000000;
-constexpr int kMaxPriority = 99;  ///< SCHED_FIFO's highest on Linux
+constexpr int kMaxPriority = 99;            ///< SCHED_FIFO's highest on Linux
+constexpr std::size_t kMaxNameLength = 15;  ///< a thread's name, without its terminating 0
 
 timespec toTimespec(std::int64_t nanoseconds) {
   timespec time{};
@@ -35,7 +36,8 @@ std::int64_t monotonicNanoseconds() {
 
 PeriodicThread::~PeriodicThread() { stop(); }
 
-void PeriodicThread::start(std::chrono::nanoseconds period, int priority, Callback callback) {
+void PeriodicThread::start(std::chrono::nanoseconds period, int priority, Callback callback,
+                           const std::string& name) {
   if (period.count() <= 0) {
     throw std::invalid_argument("PeriodicThread: the period must be positive, got " +
                                 std::to_string(period.count()) + " ns");
@@ -55,8 +57,9 @@ void PeriodicThread::start(std::chrono::nanoseconds period, int priority, Callba
   missed_.store(0, std::memory_order_relaxed);
   std::promise<int> started;
   std::future<int> outcome = started.get_future();
-  thread_ = std::thread(&PeriodicThread::run, this, static_cast<std::int64_t>(period.count()),
-                        priority, std::move(callback), std::move(started));
+  thread_ =
+      std::thread(&PeriodicThread::run, this, static_cast<std::int64_t>(period.count()), priority,
+                  std::move(callback), name.substr(0, kMaxNameLength), std::move(started));
   const int error = outcome.get();
   if (error != 0) {
     thread_.join();  // it has returned already
@@ -74,7 +77,10 @@ void PeriodicThread::stop() {
 }
 
 void PeriodicThread::run(std::int64_t period, int priority, const Callback& callback,
-                         std::promise<int> started) {
+                         const std::string& name, std::promise<int> started) {
+  if (!name.empty()) {
+    pthread_setname_np(pthread_self(), name.c_str());  // only fails for a name too long
+  }
   if (priority > 0) {
     sched_param parameters{};
     parameters.sched_priority = priority;

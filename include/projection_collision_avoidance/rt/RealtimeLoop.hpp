@@ -63,11 +63,14 @@ class PeriodicThread {
   ///                  1 to 99: SCHED_FIFO at that priority (pthread_setschedparam), set by the
   ///                  thread before its first deadline
   /// @param callback  what to run at each deadline
+  /// @param name      the thread's name as ps and /proc/<pid>/task/<tid>/comm show it (at most
+  ///                  15 characters are kept); empty: the caller's
   /// @throws std::invalid_argument for a period <= 0, a priority outside [0, 99] or no callback
   /// @throws std::logic_error when the thread already runs
   /// @throws PriorityRefused when the priority is refused; the thread has then ended
   /// @throws std::system_error when no thread can be created
-  void start(std::chrono::nanoseconds period, int priority, Callback callback);
+  void start(std::chrono::nanoseconds period, int priority, Callback callback,
+             const std::string& name = std::string());
 
   /// Asks the thread to end and joins it; returns once it has ended. Does nothing when it does
   /// not run. Not to be called from the callback.
@@ -85,7 +88,8 @@ class PeriodicThread {
  private:
   /// The thread's body: sets the priority, reports the outcome to start() through @p started
   /// (0 or the errno), then loops until stop().
-  void run(std::int64_t period, int priority, const Callback& callback, std::promise<int> started);
+  void run(std::int64_t period, int priority, const Callback& callback, const std::string& name,
+           std::promise<int> started);
   /// Sleeps until @p deadline (monotonic ns) in slices; false when asked to stop meanwhile.
   bool sleepUntil(std::int64_t deadline) const;
 

@@ -26,18 +26,20 @@ std::int64_t steadyNanoseconds() {
 }  // namespace
 
 FollowerLoop::FollowerLoop(ros::NodeHandle nh, std::string node_name,
-                           const FollowerNodeOptions& options, double control_rate,
-                           FollowerCycle* cycle, FollowerOutputs* outputs)
+                           const std::string& thread_name, const FollowerNodeOptions& options,
+                           double control_rate, FollowerCycle* cycle, FollowerOutputs* outputs)
     : name_(std::move(node_name)),
       count_timer_periods_(options.trigger == ControlTrigger::kTimer),
+      post_outputs_(options.control_loop == ControlLoop::kThread),
       cycle_(cycle),
       outputs_(outputs),
       period_(1.0 / control_rate) {
-  if (options.control_loop == ControlLoop::kThread) {
-    const int priority = options.control_priority;
+  if (options.control_loop == ControlLoop::kThread || !ros::Time::isSimTime()) {
+    const int priority = post_outputs_ ? options.control_priority : 0;
     try {
-      thread_.start(std::chrono::nanoseconds(std::llround(1e9 / control_rate)), priority,
-                    [this](const PeriodicTick& tick) { onThreadTick(tick); });
+      thread_.start(
+          std::chrono::nanoseconds(std::llround(1e9 / control_rate)), priority,
+          [this](const PeriodicTick& tick) { onThreadTick(tick); }, thread_name);
     } catch (const PriorityRefused& error) {
       throw ParameterError("~control_priority",
                            "SCHED_FIFO priority " + std::to_string(priority) +
@@ -93,7 +95,11 @@ void FollowerLoop::onThreadTick(const PeriodicTick& tick) {
     const std::uint64_t most = std::numeric_limits<std::uint32_t>::max();
     cycle_->tick(rosNanoseconds, tick.actual, delay,
                  static_cast<std::uint32_t>(std::min(tick.skipped, most)), &thread_output_);
-    outputs_->post(thread_output_);
+    if (post_outputs_) {
+      outputs_->post(thread_output_);
+    } else {
+      outputs_->publish(thread_output_);
+    }
   } catch (const std::exception& error) {
     ROS_ERROR_STREAM_THROTTLE(5.0, name_ << ": control tick failed: " << error.what());
   }

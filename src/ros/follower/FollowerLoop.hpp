@@ -18,23 +18,32 @@ namespace projection_collision_avoidance {
 
 /// What runs the follower's fixed-rate tick (~control_loop) and its period accounting.
 ///
-/// "timer": a ros::Timer (ROS time; simulated time works) on a callback queue and spinner thread
-/// of their own, so that a flood of input messages cannot delay a tick; the tick publishes on
-/// that thread. Missed periods (~trigger timer): the timer's expected times more than 1.5
-/// periods apart count round(gap / T) - 1.
+/// "timer" on simulated time: a ros::Timer on a callback queue and spinner thread of their own,
+/// so that a flood of input messages cannot delay a tick; the tick publishes on that thread.
+/// Missed periods (~trigger timer): the timer's expected times more than 1.5 periods apart count
+/// round(gap / T) - 1.
 ///
-/// "thread": a PeriodicThread sleeping to absolute CLOCK_MONOTONIC deadlines k T, optionally
-/// under SCHED_FIFO (~control_priority), stamped with ros::Time::now() (wall time only). Its tick
-/// allocates and blocks on nothing (with ~trigger timer): the cycle reads lock-free slots and
-/// its output goes through FollowerOutputs::post() to the outputs' thread. Missed periods: the
-/// deadlines the thread skipped.
+/// "timer" on wall time: a PeriodicThread (no real-time priority) sleeping to absolute
+/// CLOCK_MONOTONIC deadlines k T; the tick publishes on that thread. One wake-up per tick, where
+/// a ros::Timer costs two (roscpp's timer thread hands each call to the spinner); a step of the
+/// system clock does not move the deadlines. Missed periods: the deadlines the thread skipped.
+///
+/// "thread": the same PeriodicThread, optionally under SCHED_FIFO (~control_priority), refused
+/// on simulated time. Its tick allocates and blocks on nothing (with ~trigger timer): the cycle
+/// reads lock-free slots and its output goes through FollowerOutputs::post() to the outputs'
+/// thread.
+///
+/// On either thread the tick is stamped with ros::Time::now(); the thread is named
+/// @p thread_name (ps, /proc/<pid>/task/<tid>/comm), so that its CPU time can be told apart.
 class FollowerLoop {
  public:
   /// Starts the loop at @p control_rate Hz.
   /// @throws ParameterError naming ~control_priority when the kernel refuses the priority
   /// @param node_name prefix of the log lines
-  FollowerLoop(ros::NodeHandle nh, std::string node_name, const FollowerNodeOptions& options,
-               double control_rate, FollowerCycle* cycle, FollowerOutputs* outputs);
+  /// @param thread_name name of the tick's thread on wall time (at most 15 characters kept)
+  FollowerLoop(ros::NodeHandle nh, std::string node_name, const std::string& thread_name,
+               const FollowerNodeOptions& options, double control_rate, FollowerCycle* cycle,
+               FollowerOutputs* outputs);
   /// Stops the loop (the thread within one period, at most 10 ms, and a running tick).
   ~FollowerLoop();
   FollowerLoop(const FollowerLoop&) = delete;
@@ -46,6 +55,7 @@ class FollowerLoop {
 
   std::string name_;
   bool count_timer_periods_;  ///< ~trigger timer: the timer's skipped periods are missed
+  bool post_outputs_;         ///< "thread": outputs go to the outputs' thread
   FollowerCycle* cycle_;
   FollowerOutputs* outputs_;
   double period_;
