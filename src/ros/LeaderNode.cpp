@@ -1,5 +1,6 @@
 #include "projection_collision_avoidance/ros/LeaderNode.hpp"
 
+#include <boost/make_shared.hpp>
 #include <geometry_msgs/AccelStamped.h>
 
 #include "projection_collision_avoidance/LeaderBroadcast.h"
@@ -93,17 +94,19 @@ void LeaderNode::onTick(const ros::TimerEvent& event) {
   }
   const double t = secondsBetween(stamp, origin_);
   const Eigen::VectorXd input = scenario_.leader_input.value(t, axes_);
-  command_publisher_.publish(toAccelMsg(input, stamp, options_.leader_frame));
+  // Shared pointers: a subscriber in the same process gets the message itself (no copy).
+  command_publisher_.publish(boost::make_shared<geometry_msgs::AccelStamped>(
+      toAccelMsg(input, stamp, options_.leader_frame)));
   if (!have_odometry_) {
     return;
   }
-  LeaderBroadcast broadcast;
-  broadcast.header = odometry_.header;
-  broadcast.position = toStdVector(state_.head(axes_));
-  broadcast.velocity = toStdVector(state_.tail(axes_));
-  broadcast.input = toStdVector(input);
+  auto broadcast = boost::make_shared<LeaderBroadcast>();
+  broadcast->header = odometry_.header;
+  broadcast->position = toStdVector(state_.head(axes_));
+  broadcast->velocity = toStdVector(state_.tail(axes_));
+  broadcast->input = toStdVector(input);
   if (options_.share_disturbance) {
-    broadcast.disturbance = toStdVector(scenario_.disturbance.value(t, 2 * axes_));
+    broadcast->disturbance = toStdVector(scenario_.disturbance.value(t, 2 * axes_));
   }
   broadcast_publisher_.publish(broadcast);
 }

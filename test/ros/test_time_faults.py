@@ -11,6 +11,10 @@ timeout, and tracks again after every jump.
 were flowing all along), counts the stalled periods as missed, keeps tracking, and no two
 consecutive commands differ by more than ~jerk_limit / ~control_rate (controller.jerk_limit).
 
+~case "plant_stall": pair.launch on wall time; the plant is stopped with SIGSTOP for ~stall_s
+seconds and continued. It drops the backlog (and says so) rather than catching up ticks stamped
+in the past, so it refuses no command as stamped in the future, and the follower tracks again.
+
 Parameters: ~wall_deadline (s) for each awaited condition, ~measurement_timeout (s)."""
 
 import math
@@ -28,6 +32,7 @@ import rosbag
 import rospy
 import rostest
 from projection_collision_avoidance.msg import FollowerStatus, RelativeMeasurement
+from rosgraph_msgs.msg import Log
 
 import ros_test_helpers as helpers
 
@@ -92,6 +97,44 @@ class TimeFaults(unittest.TestCase):
             after = [s for _, s in statuses if s.time_jumps == jump]
             self.assertTrue(any(s.mode == FollowerStatus.MODE_TRACKING for s in after),
                             f"no tracking after jump {jump}")
+
+    def stop_and_continue(self, node):
+        """SIGSTOP to @p node for ~stall_s s, then SIGCONT; returns time.monotonic() at the end."""
+        code, _, api = rospy.get_master().lookupNode(node)
+        self.assertEqual(code, 1, f"{node} unknown to the master")
+        pid = xmlrpc.client.ServerProxy(api).getPid(rospy.get_name())[2]
+        os.kill(pid, signal.SIGSTOP)
+        try:
+            time.sleep(rospy.get_param("~stall_s"))
+        finally:
+            os.kill(pid, signal.SIGCONT)
+        return time.monotonic()
+
+    def check_plant_stall(self):
+        node = rospy.get_param("~plant_node")
+        lines = []
+        rospy.Subscriber("/rosout", Log, lambda msg: lines.append((time.monotonic(), msg))
+                         if msg.name == node else None)
+        self.wait_for(lambda: self.latest() is not None and
+                      self.latest().mode == FollowerStatus.MODE_TRACKING and
+                      self.latest().ticks > 300, "the follower does not track")
+        stalled = time.monotonic()
+        resumed = self.stop_and_continue(node)
+        self.wait_for(lambda: any(t > resumed for t, _ in self.statuses) and
+                      [s for t, s in self.statuses if t > resumed][-1].mode ==
+                      FollowerStatus.MODE_TRACKING, "tracking after the plant resumed")
+        self.wait_for(lambda: any("behind the wall clock" in m.msg for t, m in lines if t > stalled),
+                      "the plant saying it dropped its backlog")
+        # A second of tracking after the resume: a refusal would be logged by then.
+        self.wait_for(lambda: sum(1 for t, s in self.statuses if t > resumed and
+                                  s.mode == FollowerStatus.MODE_TRACKING) >=
+                      rospy.get_param("~control_rate"), "a second of tracking after the resume")
+        future = [m.msg for t, m in lines if t > stalled and
+                  ("future stamp" in m.msg or "ahead of the clock" in m.msg)]
+        self.assertFalse(future, f"the plant refused commands as stamped in the future: {future}")
+        with self.lock:
+            after = [s for t, s in self.statuses if t > resumed]
+        self.assert_honest(after)
 
     def check_stall(self):
         node = rospy.get_param("~follower_node")

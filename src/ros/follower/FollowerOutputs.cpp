@@ -5,6 +5,7 @@
 #include <sstream>
 #include <utility>
 
+#include <boost/make_shared.hpp>
 #include <geometry_msgs/AccelStamped.h>
 #include <visualization_msgs/MarkerArray.h>
 
@@ -73,21 +74,24 @@ void FollowerOutputs::publish(const FollowerCycleOutput& out) {
   remember(out);
   if (out.stepped) {
     const ros::Time stamp = rosTimeOf(out.stamp_ns);
-    command_publisher_.publish(toAccelMsg(out.status.command, stamp, options_.follower_frame));
+    // Published as shared pointers: a subscriber in the same process (a nodelet) gets the
+    // message itself, neither serialised nor copied.
+    command_publisher_.publish(boost::make_shared<geometry_msgs::AccelStamped>(
+        toAccelMsg(out.status.command, stamp, options_.follower_frame)));
     // The other messages are made only while someone subscribes to them.
     if (broadcast_publisher_.getNumSubscribers() > 0) {
-      LeaderBroadcast broadcast;  // for a follower behind this one: its acceleration, no state
-      broadcast.header.stamp = stamp;
-      broadcast.header.frame_id = options_.follower_frame;
-      broadcast.input = toStdVector(out.status.command);
+      auto broadcast = boost::make_shared<LeaderBroadcast>();  // its acceleration, no state
+      broadcast->header.stamp = stamp;
+      broadcast->header.frame_id = options_.follower_frame;
+      broadcast->input = toStdVector(out.status.command);
       broadcast_publisher_.publish(broadcast);
     }
     // Every so many steps, and at every change of mode (a fallback is never left out).
     if (steps_per_status_ > 0 &&
         ((out.steps - 1) % steps_per_status_ == 0 || out.mode != status_mode_)) {
       if (status_publisher_.getNumSubscribers() > 0) {
-        status_publisher_.publish(
-            toStatusMsg(out, inputs_->stats(out.now_ns), member_, options_.follower_frame));
+        status_publisher_.publish(boost::make_shared<FollowerStatus>(
+            toStatusMsg(out, inputs_->stats(out.now_ns), member_, options_.follower_frame)));
       }
       status_mode_ = out.mode;
     }

@@ -1,6 +1,7 @@
 #include "plant/PlantClock.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <sstream>
 #include <utility>
@@ -32,8 +33,29 @@ PlantClock::PlantClock(ros::NodeHandle nh, std::string node_name, const PlantNod
     wall_timer_ =
         nh.createWallTimer(ros::WallDuration(1.0 / (options_.rate * options_.real_time_factor)),
                            &PlantClock::onWallTick, this);
-  } else {
+  } else if (ros::Time::isSimTime()) {
     timer_ = nh.createTimer(ros::Duration(1.0 / options_.rate), &PlantClock::onRosTick, this);
+  } else {
+    thread_.start(
+        std::chrono::nanoseconds(std::llround(1e9 / options_.rate)), 0,
+        [this](const PeriodicTick& tick) { onThreadTick(tick); }, "plant tick");
+  }
+}
+
+PlantClock::~PlantClock() { thread_.stop(); }
+
+void PlantClock::onThreadTick(const PeriodicTick& tick) {
+  if (!ros::ok()) {  // shutting down: a timer's callback would not run either
+    return;
+  }
+  const std::lock_guard<std::mutex> lock(*mutex_);
+  try {
+    // When the tick was due, on ROS (wall) time: now less how late the thread woke.
+    ros::Time expected;
+    expected.fromNSec(nanosecondsOf(ros::Time::now()) - (tick.actual - tick.expected));
+    rosTick(expected);
+  } catch (const std::exception& error) {
+    ROS_ERROR_STREAM_THROTTLE(5.0, name_ << ": tick failed: " << error.what());
   }
 }
 
@@ -189,14 +211,36 @@ void PlantClock::rosTick(const ros::Time& expected) {
       return;
     }
   }
-  const long due =
+  long due =
       static_cast<long>(std::floor(secondsBetween(now, origin_) * options_.rate + kTickTolerance));
   if (due < next_tick_ - 1) {
     return;  // ROS time went back: wait for it to reach the next tick again
   }
+  if (!ros::Time::isSimTime()) {
+    due = dropWallBacklog(due, now);
+  }
   // Catch up every due tick, at most one second of them per call.
   runThrough(std::min(due, next_tick_ + std::max(1L, std::lround(options_.rate))),
              ros::WallTime::now());
+}
+
+long PlantClock::dropWallBacklog(long due, const ros::Time& now) {
+  const long max_catch_up = std::max(1L, std::lround(kMaxCatchUp * options_.rate));
+  if (due - next_tick_ < max_catch_up) {
+    return due;
+  }
+  // The ticks from next_tick_ on are stamped from now: no stamp lags the wall clock by more than
+  // kMaxCatchUp, so neither the samples nor the judgement of the commands (stamped by their
+  // senders on the wall clock) fall behind; scenario time runs slower instead.
+  const double behind = static_cast<double>(due - next_tick_ + 1) / options_.rate;
+  dropped_seconds_ += behind;
+  origin_ = now - ros::Duration(static_cast<double>(next_tick_) / options_.rate);
+  ROS_WARN_STREAM_THROTTLE(5.0, name_ << ": " << behind
+                                      << " s behind the wall clock (the plant was stalled or "
+                                         "cannot keep up with ~rate): those ticks are dropped, "
+                                         "scenario time runs slower than wall time ("
+                                      << dropped_seconds_ << " s dropped in all)");
+  return next_tick_;
 }
 
 }  // namespace projection_collision_avoidance

@@ -9,6 +9,7 @@
 #include <ros/ros.h>
 
 #include "projection_collision_avoidance/ros/InputAdmission.hpp"
+#include "projection_collision_avoidance/rt/RealtimeLoop.hpp"
 
 #include "plant/PlantOptions.hpp"
 
@@ -22,7 +23,10 @@ namespace projection_collision_avoidance {
 /// 90 % of the factor asked for is reported every 5 s). Otherwise it ticks on ROS time, catching
 /// up every tick that is due (at most one second of them per callback); scenario time is ROS
 /// time under use_sim_time and the time since the first tick otherwise; when ROS time goes back
-/// it waits for it to reach the next tick again.
+/// it waits for it to reach the next tick again. On wall time those ticks run on a thread of its
+/// own ("plant tick") sleeping to monotonic deadlines, one wake-up per tick. On wall time a backlog of more than 50 ms
+/// (a stall, or more agents than the plant can integrate at ~rate) is dropped and reported, the
+/// ticks after it stamped from the wall clock: stamps stay within 50 ms of the senders' clocks.
 ///
 /// Holding simulated time (publish_clock only): with ~wait_for_followers it stays at its start
 /// until every follower listens (or that many wall s have passed), and the wall schedule starts
@@ -56,12 +60,21 @@ class PlantClock {
   ros::Time now() const;
   /// Stops the timers (no tick after this returns to its callback).
   void halt();
+  /// Stops the tick thread (wall time), waiting for a running tick. Not from a tick.
+  ~PlantClock();
+  PlantClock(const PlantClock&) = delete;
+  PlantClock& operator=(const PlantClock&) = delete;
 
  private:
   void onWallTick(const ros::WallTimerEvent& event);
   void onRosTick(const ros::TimerEvent& event);
+  /// Wall time: the tick thread's call.
+  void onThreadTick(const PeriodicTick& tick);
   /// @param expected when the timer was due (its TimerEvent's current_expected)
   void rosTick(const ros::Time& expected);
+  /// Wall time: the last tick to run at ROS time @p now, given the tick @p due by the origin;
+  /// a backlog of more than kMaxCatchUp s is dropped (the origin moved to now) and reported.
+  long dropWallBacklog(long due, const ros::Time& now);
   /// Runs the ticks from next_tick_ through @p due while the plant runs (and, in lockstep, the
   /// commands answer), at wall time @p wall_now.
   void runThrough(long due, const ros::WallTime& wall_now);
@@ -85,10 +98,12 @@ class PlantClock {
   bool holding_ = false;                ///< lockstep: a tick waits for commands since hold_start_
   ros::WallTime hold_start_;
   std::uint64_t lockstep_timeouts_ = 0;  ///< ticks that ran without every command
+  double dropped_seconds_ = 0.0;         ///< wall time: backlog dropped so far (s)
   ros::WallTime rate_check_wall_;
   long rate_check_tick_ = 0;
   ros::WallTimer wall_timer_;
   ros::Timer timer_;
+  PeriodicThread thread_;  ///< wall time (no ~publish_clock, no use_sim_time); stopped first
 };
 
 }  // namespace projection_collision_avoidance

@@ -7,6 +7,7 @@
 #include <sstream>
 #include <utility>
 
+#include <boost/make_shared.hpp>
 #include <geometry_msgs/TransformStamped.h>
 #include <nav_msgs/Odometry.h>
 #include <rosgraph_msgs/Clock.h>
@@ -257,7 +258,9 @@ void PlantWorld::sampleAgent(Agent* agent, const ros::Time& stamp,
     return;
   }
   const Eigen::VectorXd state = agent->integrator.state();
-  agent->odom_publisher.publish(toOdometryMsg(state, stamp, options_.world_frame, agent->frame));
+  // Shared pointers: a subscriber in the same process (nodelets) gets the message itself.
+  agent->odom_publisher.publish(boost::make_shared<nav_msgs::Odometry>(
+      toOdometryMsg(state, stamp, options_.world_frame, agent->frame)));
   transforms->push_back(
       toTransformMsg(state.head(axes_), stamp, options_.world_frame, agent->frame));
 }
@@ -287,7 +290,10 @@ void PlantWorld::advanceAgent(Agent* agent, double t, const ros::Time& stamp) {
     return;
   }
   const GenericDimensions::InputVector command = commandAt(agent, stamp);
-  agent->applied_command_publisher.publish(toAccelMsg(command, stamp, agent->frame));
+  if (agent->applied_command_publisher.getNumSubscribers() > 0) {
+    agent->applied_command_publisher.publish(
+        boost::make_shared<geometry_msgs::AccelStamped>(toAccelMsg(command, stamp, agent->frame)));
+  }
   agent->integrator.advance(t, command);
 }
 
@@ -311,8 +317,8 @@ void PlantWorld::publishMeasurement(int index, long k) {
   long sampled = 0;
   Eigen::VectorXd measured;
   while (channels_->deliver(index, k, &sampled, &measured)) {
-    follower.measurement_publisher.publish(
-        toRelativeMeasurementMsg(measured, clock_->stampOf(sampled), options_.world_frame));
+    follower.measurement_publisher.publish(boost::make_shared<RelativeMeasurement>(
+        toRelativeMeasurementMsg(measured, clock_->stampOf(sampled), options_.world_frame)));
   }
 }
 
