@@ -42,7 +42,9 @@ def diagnostics(msg):
     for s in msg.status:
         values = {kv.key: kv.value for kv in s.values}
         if all(k in values for k in KEYS):
-            print(json.dumps({"t": msg.header.stamp.to_sec(), "name": s.name,
+            # In one manager every follower's status has the manager's name: its hardware_id
+            # (the follower's frame) tells them apart.
+            print(json.dumps({"t": msg.header.stamp.to_sec(), "name": s.name + "/" + s.hardware_id,
                               **{k: values[k] for k in KEYS}}), flush=True)
 def log(msg):
     if msg.name == "/plant" and "behind the wall clock" in msg.msg:

@@ -67,6 +67,7 @@ void LeaderNode::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
     odometry_ = *msg;
     state_ = state;
     have_odometry_ = true;
+    odometry_fresh_ = true;
     odometry_guard_.accept(nanosecondsOf(msg->header.stamp), nanosecondsOf(now));
   });
 }
@@ -97,9 +98,10 @@ void LeaderNode::onTick(const ros::TimerEvent& event) {
   // Shared pointers: a subscriber in the same process gets the message itself (no copy).
   command_publisher_.publish(boost::make_shared<geometry_msgs::AccelStamped>(
       toAccelMsg(input, stamp, options_.leader_frame)));
-  if (!have_odometry_) {
-    return;
+  if (!have_odometry_ || !odometry_fresh_) {
+    return;  // one broadcast per odometry: its stamp is the odometry's, and a repeat is refused
   }
+  odometry_fresh_ = false;
   auto broadcast = boost::make_shared<LeaderBroadcast>();
   broadcast->header = odometry_.header;
   broadcast->position = toStdVector(state_.head(axes_));

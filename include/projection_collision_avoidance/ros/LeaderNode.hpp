@@ -25,7 +25,8 @@ struct LeaderNodeOptions {
 /// Every 1 / rate s of ROS time it publishes `leader/command` (geometry_msgs/AccelStamped, u_1
 /// sampled at the tick, stamped with the tick) and, once a `leader/odom` (nav_msgs/Odometry)
 /// has arrived, `leader/broadcast` (LeaderBroadcast: position and velocity of the latest odom,
-/// u_1(t), and u_d(t) when shared, under the odom's header). Scenario time t is ROS time under
+/// u_1(t), and u_d(t) when shared, under the odom's header; one per odom, as a follower refuses
+/// a repeated stamp). Scenario time t is ROS time under
 /// use_sim_time (the plant's /clock starts at 0) and the time since the first tick otherwise.
 class LeaderNode {
  public:
@@ -46,6 +47,7 @@ class LeaderNode {
   nav_msgs::Odometry odometry_;  ///< latest accepted
   Eigen::VectorXd state_;        ///< its [p; v]
   bool have_odometry_ = false;
+  bool odometry_fresh_ = false;  ///< an odometry not broadcast yet
   /// s by which an odometry stamp may lie ahead of the leader's clock
   static constexpr double kMaxFutureStamp = 0.1;
   InputGuard odometry_guard_{"leader/odom", {"", kMaxFutureStamp, 0.0}};
