@@ -16,6 +16,7 @@ rate=${3:-1000}
 seconds=${4:-40}
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
+[ -z "${KEEP:-}" ] || trap - EXIT
 set +u  # the workspace's setup scripts read unset variables
 # shellcheck disable=SC1091
 source "$build/devel/setup.bash"

@@ -2,8 +2,10 @@
 
   callgrind_parts.py ANNOTATE.txt CALLGRIND.OUT
 
-ANNOTATE.txt: `callgrind_annotate --inclusive=yes` of CALLGRIND.OUT. The ticks are the calls of
-FollowerCycle::tick counted in CALLGRIND.OUT; a part's figure is the inclusive instruction count of
+ANNOTATE.txt: `callgrind_annotate --inclusive=yes` of CALLGRIND.OUT. Under valgrind the threads
+run one at a time, so a thread's idle loop (ros::spin's timed waits) can cost instructions it does
+not cost outside; the parts below are the work done, not the waiting. The ticks are the calls of
+FollowerCycle::tickLatched (the tick once its inputs are latched) counted in CALLGRIND.OUT; a part's figure is the inclusive instruction count of
 its functions (the first function matching each pattern, in the order given) divided by the ticks.
 """
 
@@ -18,12 +20,14 @@ PARTS = [
     ("input callbacks: relative_measurement (guard, admit)",
      ["FollowerInputs::onMeasurement"]),
     ("input callbacks: leader_broadcast (guard, admit)", ["FollowerInputs::onLeaderBroadcast"]),
-    ("spinner threads (callback queues: the inputs' or the timer's hand-off)",
-     ["ros::CallbackQueue::callAvailable", "ros::CallbackQueue::callOne"]),
+    ("callbacks run from callback queues (the inputs', the timer's)",
+     ["ros::CallbackQueue::callOneCB"]),
     ("roscpp timer thread (the timer's hand-off)", ["TimerManager<ros::Time, ros::Duration, ros::TimerEvent>::threadFunc"]),
     ("tick thread (PeriodicThread)", ["PeriodicThread::run"]),
-    ("control tick: FollowerCycle::tick (mode, accounting, the core's step)",
-     ["FollowerCycle::tick("]),
+    ("control tick: latching the inputs (FollowerCycle::latchInputs)",
+     ["FollowerCycle::latchInputs("]),
+    ("control tick: FollowerCycle::tickLatched (mode, accounting, the core's step)",
+     ["FollowerCycle::tickLatched("]),
     ("the core's step: DynamicFollowerController::step", ["DynamicFollowerController::step("]),
     ("outputs: FollowerOutputs::publish (all of it)", ["FollowerOutputs::publish("]),
     ("publication of command (AccelStamped)", ["Publisher::publish<geometry_msgs::AccelStamped_"]),
@@ -74,9 +78,9 @@ def inclusive(annotate):
 
 def main():
     annotate, raw = sys.argv[1], sys.argv[2]
-    ticks = call_counts(raw, "FollowerCycle::tick(")
+    ticks = call_counts(raw, "FollowerCycle::tickLatched(")
     if ticks == 0:
-        sys.exit("callgrind_parts: no call of FollowerCycle::tick in " + raw)
+        sys.exit("callgrind_parts: no call of FollowerCycle::tickLatched in " + raw)
     rows = inclusive(annotate)
     print("ticks: %d" % ticks)
     print("| part | instructions per tick |")
