@@ -187,7 +187,7 @@ def command_report(args):
     rows = [json.loads(line) for line in open(args.json)]
     header = ["N", "manager (% of a core)", "followers' ticks (%)", "plant tick (%)",
               "other threads (%)", "us per follower tick", "us per plant agent and tick",
-              "other threads, us per follower tick", "min follower rate (Hz)",
+              "other threads per follower tick (us)", "min follower rate (Hz)",
               "max late ticks (%)", "tracking", "plant drops", "holds"]
     with open(args.csv, "w") as out:
         out.write(",".join(header) + "\n")
@@ -223,7 +223,7 @@ def command_report(args):
     right2 = right.twinx()
     right2.plot(n, [r["min_rate"] for r in rows], "r.-", label="min follower rate")
     right2.set_ylabel("min follower rate (Hz)", color="r")
-    right.legend(loc="upper left")
+    right.legend(loc="center left")
     right.grid(True, alpha=0.3)
     fig.tight_layout()
     fig.savefig(args.png, dpi=110)

@@ -209,6 +209,9 @@ def main(argv=None):
     else:
         lines.append("No doc/formation_scale.md.")
     lines.append("")
+    lines += ["## The nodes' CPU time", "",
+              "CPU per tick of the ROS nodes, its parts, and platoons in one nodelet manager: "
+              "[node_cpu.md](node_cpu.md) (`experiments/node_cpu/`).", ""]
     with open(args.out, "w") as handle:
         handle.write("\n".join(lines))
 

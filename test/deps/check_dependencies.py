@@ -60,7 +60,10 @@ DEVELOPMENT_SCRIPTS = {"scripts/test.sh", "scripts/build.sh", "scripts/sanitize.
                        "experiments/performance/performance_report.py",
                        "experiments/performance/solver_comparison.py",
                        "experiments/ros_latency/run.sh", "experiments/ros_latency/ros_latency.py",
-                       "experiments/fault_table/run.sh"}
+                       "experiments/fault_table/run.sh", "experiments/node_cpu/run.sh",
+                       "experiments/node_cpu/node_cpu.py", "experiments/node_cpu/callgrind.sh",
+                       "experiments/node_cpu/callgrind_parts.py",
+                       "experiments/node_cpu/platoon_cpu.py"}
 # Files under test/ that the package installs as programs: what they use is a run-time need.
 INSTALLED_PROGRAMS = {"test/reference/reference_sim.py"}
 # The experiments' shared Python helpers, imported by the experiments as local modules.
