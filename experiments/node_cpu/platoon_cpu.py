@@ -74,6 +74,32 @@ def manager_pid(launch_pid):
     return None
 
 
+def launch_children(launch_pid):
+    try:
+        with open("/proc/%d/task/%d/children" % (launch_pid, launch_pid)) as f:
+            return [int(p) for p in f.read().split()]
+    except OSError:
+        return []
+
+
+def total_jiffies(pids):
+    total = 0
+    for pid in pids:
+        try:
+            total += cpu_jiffies(pid)
+        except OSError:
+            pass
+    return total
+
+
+def machine_jiffies():
+    """(busy, all) clock ticks of every core, from /proc/stat."""
+    with open("/proc/stat") as f:
+        fields = [int(x) for x in f.readline().split()[1:]]
+    idle = fields[3] + fields[4]
+    return sum(fields) - idle, sum(fields)
+
+
 def read_lines(path):
     out = []
     with open(path) as f:
@@ -114,11 +140,14 @@ def measure(args, n):
         else:
             raise RuntimeError("N=%d: %d followers ticking within the deadline" % (n, len(ticking)))
         time.sleep(args.settle)
+        others = [p for p in launch_children(launch.pid) if p != pid]  # the nodelet loaders
         jiffies0, threads0 = cpu_jiffies(pid), thread_ns(pid)
+        others0, busy0 = total_jiffies(others), machine_jiffies()
         t0 = time.time()
         time.sleep(args.window)
         t1 = time.time()
         jiffies1, threads1 = cpu_jiffies(pid), thread_ns(pid)
+        others1, busy1 = total_jiffies(others), machine_jiffies()
         time.sleep(2.5)  # the diagnostics after t1
     finally:
         stop_process(reader, 5.0)
@@ -135,7 +164,7 @@ def measure(args, n):
     for d in lines:
         if "name" in d:
             per.setdefault(d["name"], []).append(d)
-    rates, late, missed, tracking = [], [], [], 0
+    rates, late, missed, tracking, worst = [], [], [], 0, []
     for name, seen in per.items():
         before = [d for d in seen if d["t"] <= t0]
         after = [d for d in seen if d["t"] >= t1]
@@ -147,6 +176,7 @@ def measure(args, n):
         late.append((int(b["late_periods"]) - int(a["late_periods"])) / max(1, ticks))
         missed.append(int(b["missed_periods"]) - int(a["missed_periods"]))
         tracking += 1 if b["mode"] == "tracking" else 0
+        worst.append((missed[-1], name))
     dropped = [d["plant_dropped"] for d in lines if "plant_dropped" in d and t0 <= d["t"] <= t1]
     manager_cpu = (jiffies1 - jiffies0) / os.sysconf("SC_CLK_TCK")
     ticks_per_s = n * args.rate
@@ -162,6 +192,10 @@ def measure(args, n):
         "plant_agent_us": 1e6 * groups["plant tick"] / (args.rate * window * (n + 1)),
         "other_us_per_follower_tick": 1e6 * groups["other threads"] / (ticks_per_s * window),
         "load": os.getloadavg()[0],
+        "loaders_percent": 100.0 * (others1 - others0) / os.sysconf("SC_CLK_TCK") / window,
+        "loaders": len(others),
+        "machine_busy_percent": 100.0 * (busy1[0] - busy0[0]) / max(1, busy1[1] - busy0[1]),
+        "most_missed": sorted(worst, reverse=True)[:5],
     })
     result["holds"] = (len(rates) == n and result["min_rate"] >= 0.99 * args.rate and
                        result["max_late"] <= 0.01 and tracking == n and not dropped)
@@ -176,11 +210,13 @@ def command_run(args):
             out.flush()
             print("N=%3d  manager %6.1f %% (stat %6.1f %%)  follower tick %6.1f us (%.3f %% each)"
                   "  plant %5.1f us per agent  other %5.1f us per follower tick  min rate %.2f Hz"
-                  "  max late %.2f %%  tracking %d/%d  plant drops %d  holds %s" % (
+                  "  max late %.2f %%  tracking %d/%d  plant drops %d  loaders %.1f %%"
+                  "  machine busy %.0f %%  most missed %s  holds %s" % (
                       n, r["manager_percent_sched"], r["manager_percent_stat"],
                       r["follower_tick_us"], r["follower_percent"], r["plant_agent_us"],
                       r["other_us_per_follower_tick"], r["min_rate"], 100 * r["max_late"],
-                      r["tracking"], n, r["plant_drops"], r["holds"]), flush=True)
+                      r["tracking"], n, r["plant_drops"], r["loaders_percent"],
+                      r["machine_busy_percent"], r["most_missed"][:3], r["holds"]), flush=True)
 
 
 def command_report(args):
