@@ -148,7 +148,7 @@ def measure(args, n):
         t1 = time.time()
         jiffies1, threads1 = cpu_jiffies(pid), thread_ns(pid)
         others1, busy1 = total_jiffies(others), machine_jiffies()
-        time.sleep(2.5)  # the diagnostics after t1
+        time.sleep(3.5)  # the diagnostics after t1 (1 Hz each)
     finally:
         stop_process(reader, 5.0)
         stop_process(launch, 60.0)
@@ -224,7 +224,8 @@ def command_report(args):
     header = ["N", "manager (% of a core)", "followers' ticks (%)", "plant tick (%)",
               "other threads (%)", "us per follower tick", "us per plant agent and tick",
               "other threads per follower tick (us)", "min follower rate (Hz)",
-              "max late ticks (%)", "tracking", "plant drops", "holds"]
+              "max late ticks (%)", "most missed periods", "tracking", "plant drops",
+              "nodelet loaders (% of a core)", "machine busy (%)", "holds"]
     with open(args.csv, "w") as out:
         out.write(",".join(header) + "\n")
         for r in rows:
@@ -234,8 +235,11 @@ def command_report(args):
                 "%.1f" % g["plant tick"], "%.1f" % g["other threads"],
                 "%.1f" % r["follower_tick_us"], "%.2f" % r["plant_agent_us"],
                 "%.1f" % r["other_us_per_follower_tick"], "%.2f" % r["min_rate"],
-                "%.2f" % (100 * r["max_late"]), "%d/%d" % (r["tracking"], r["n"]),
-                r["plant_drops"], "yes" if r["holds"] else "no"]) + "\n")
+                "%.2f" % (100 * r["max_late"]), r["max_missed"],
+                "%d/%d" % (r["tracking"], r["n"]), r["plant_drops"],
+                "%.1f" % r["loaders_percent"] if "loaders_percent" in r else "",
+                "%.0f" % r["machine_busy_percent"] if "machine_busy_percent" in r else "",
+                "yes" if r["holds"] else "no"]) + "\n")
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
