@@ -156,7 +156,7 @@ def measure(args, n):
     groups = {"followers' ticks": 0.0, "plant tick": 0.0, "other threads": 0.0}
     for tid, (name, ns) in threads1.items():
         seconds = (ns - threads0.get(tid, (name, 0))[1]) * 1e-9
-        key = ("followers' ticks" if name.startswith("tick ") else
+        key = ("followers' ticks" if name.startswith(("tick ", "follower ticks")) else
                "plant tick" if name == "plant tick" else "other threads")
         groups[key] += seconds
     lines = read_lines(lines_path)

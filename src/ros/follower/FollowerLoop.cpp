@@ -34,12 +34,17 @@ FollowerLoop::FollowerLoop(ros::NodeHandle nh, std::string node_name,
       cycle_(cycle),
       outputs_(outputs),
       period_(1.0 / control_rate) {
-  if (options.control_loop == ControlLoop::kThread || !ros::Time::isSimTime()) {
-    const int priority = post_outputs_ ? options.control_priority : 0;
+  const auto period = std::chrono::nanoseconds(std::llround(1e9 / control_rate));
+  if (options.control_loop == ControlLoop::kTimer && !ros::Time::isSimTime()) {
+    shared_ = std::make_unique<SharedTicker>(
+        period, "follower ticks", [this](const PeriodicTick& tick) { onThreadTick(tick); });
+    return;
+  }
+  if (options.control_loop == ControlLoop::kThread) {
+    const int priority = options.control_priority;
     try {
       thread_.start(
-          std::chrono::nanoseconds(std::llround(1e9 / control_rate)), priority,
-          [this](const PeriodicTick& tick) { onThreadTick(tick); }, thread_name);
+          period, priority, [this](const PeriodicTick& tick) { onThreadTick(tick); }, thread_name);
     } catch (const PriorityRefused& error) {
       throw ParameterError("~control_priority",
                            "SCHED_FIFO priority " + std::to_string(priority) +
@@ -58,6 +63,7 @@ FollowerLoop::FollowerLoop(ros::NodeHandle nh, std::string node_name,
 
 FollowerLoop::~FollowerLoop() {
   thread_.stop();
+  shared_.reset();  // after a running round of the shared ticks
   timer_.stop();
   if (spinner_) {
     spinner_->stop();

@@ -10,6 +10,7 @@
 #include "projection_collision_avoidance/node/FollowerCycle.hpp"
 #include "projection_collision_avoidance/ros/InputAdmission.hpp"
 #include "projection_collision_avoidance/rt/RealtimeLoop.hpp"
+#include "projection_collision_avoidance/rt/SharedTicker.hpp"
 
 #include "follower/FollowerOptions.hpp"
 #include "follower/FollowerOutputs.hpp"
@@ -23,24 +24,27 @@ namespace projection_collision_avoidance {
 /// Missed periods (~trigger timer): the timer's expected times more than 1.5 periods apart count
 /// round(gap / T) - 1.
 ///
-/// "timer" on wall time: a PeriodicThread (no real-time priority) sleeping to absolute
-/// CLOCK_MONOTONIC deadlines k T; the tick publishes on that thread. One wake-up per tick, where
-/// a ros::Timer costs two (roscpp's timer thread hands each call to the spinner); a step of the
-/// system clock does not move the deadlines. Missed periods: the deadlines the thread skipped.
+/// "timer" on wall time: a SharedTicker, the thread (no real-time priority) that every follower
+/// of the process at this control rate shares, sleeping to absolute CLOCK_MONOTONIC deadlines
+/// k T and running the followers' ticks in turn; each tick publishes on that thread. One wake-up
+/// per period for all the followers of a nodelet manager, where a ros::Timer costs two per
+/// follower (roscpp's timer thread hands each call to a spinner); a step of the system clock does
+/// not move the deadlines. Missed periods: the deadlines the thread skipped.
 ///
 /// "thread": the same PeriodicThread, optionally under SCHED_FIFO (~control_priority), refused
 /// on simulated time. Its tick allocates and blocks on nothing (with ~trigger timer): the cycle
 /// reads lock-free slots and its output goes through FollowerOutputs::post() to the outputs'
 /// thread.
 ///
-/// On either thread the tick is stamped with ros::Time::now(); the thread is named
-/// @p thread_name (ps, /proc/<pid>/task/<tid>/comm), so that its CPU time can be told apart.
+/// On either thread the tick is stamped with ros::Time::now(); the threads are named ("follower
+/// ticks", or @p thread_name for "thread"), so that ps and /proc/<pid>/task/<tid>/comm tell their
+/// CPU time apart.
 class FollowerLoop {
  public:
   /// Starts the loop at @p control_rate Hz.
   /// @throws ParameterError naming ~control_priority when the kernel refuses the priority
   /// @param node_name prefix of the log lines
-  /// @param thread_name name of the tick's thread on wall time (at most 15 characters kept)
+  /// @param thread_name name of the "thread" loop's thread (at most 15 characters kept)
   FollowerLoop(ros::NodeHandle nh, std::string node_name, const std::string& thread_name,
                const FollowerNodeOptions& options, double control_rate, FollowerCycle* cycle,
                FollowerOutputs* outputs);
@@ -67,7 +71,8 @@ class FollowerLoop {
   ros::CallbackQueue queue_;
   ros::Timer timer_;
   std::unique_ptr<ros::AsyncSpinner> spinner_;
-  PeriodicThread thread_;  ///< started last, stopped first
+  std::unique_ptr<SharedTicker> shared_;  ///< "timer" on wall time
+  PeriodicThread thread_;                 ///< "thread"; started last, stopped first
 };
 
 }  // namespace projection_collision_avoidance
