@@ -85,6 +85,18 @@ def node_pids(launch_pid):
     return pids
 
 
+def start_launch(command, env, log_path, reader_code, reader_path):
+    """roslaunch @p command (its output to @p log_path) and a rospy reader running
+    @p reader_code (its output to @p reader_path), each in a session of its own."""
+    with open(log_path, "w") as out:
+        launch = subprocess.Popen(command, stdout=out, stderr=subprocess.STDOUT, env=env,
+                                  start_new_session=True)
+    with open(reader_path, "w") as out:
+        reader = subprocess.Popen([sys.executable, "-c", reader_code], stdout=out,
+                                  stderr=subprocess.DEVNULL, env=env, start_new_session=True)
+    return launch, reader
+
+
 def read_ticks(lines):
     """[(stamp, ticks)] from the ticks reader's output lines."""
     out = []
@@ -102,13 +114,9 @@ def measure(args, rate):
     command = ["roslaunch", "--port", str(args.port), "projection_collision_avoidance",
                "pair.launch", "scenario:=" + os.path.abspath(SCENARIO), "sim_time:=false",
                "control_rate:=%g" % rate] + args.launch_arg
-    with open(os.devnull, "w") as devnull:
-        launch = subprocess.Popen(command, stdout=devnull, stderr=subprocess.STDOUT, env=env,
-                                  start_new_session=True)
     ticks_log = os.path.join(args.work, "ticks_%g.txt" % rate)
-    with open(ticks_log, "w") as out:
-        reader = subprocess.Popen([sys.executable, "-c", TICKS], stdout=out,
-                                  stderr=subprocess.DEVNULL, env=env, start_new_session=True)
+    launch, reader = start_launch(command, env, os.path.join(args.work, "launch_%g.log" % rate),
+                                  TICKS, ticks_log)
     try:
         deadline = time.time() + 60.0
         pids = {}

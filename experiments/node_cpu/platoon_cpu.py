@@ -19,14 +19,13 @@ plant dropped no tick.
 import argparse
 import json
 import os
-import subprocess
 import sys
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "common"))
 sys.path.insert(0, HERE)
-from node_cpu import cpu_jiffies, thread_ns  # noqa: E402
+from node_cpu import cpu_jiffies, start_launch, thread_ns  # noqa: E402
 from process_control import stop as stop_process  # noqa: E402
 
 SCENARIO = os.path.join(HERE, "..", "..", "config", "scenarios", "paper_run2.yaml")
@@ -118,14 +117,10 @@ def measure(args, n):
                "formation.launch", "followers:=%d" % n, "nodelets:=true", "world_nodelets:=true",
                "scenario:=" + os.path.abspath(SCENARIO), "control_rate:=%g" % args.rate,
                "topology:=star", "shape:=line", "sim_time:=false", "rviz:=false"]
-    log_path = os.path.join(args.work, "platoon_launch_%d.log" % n)
-    with open(log_path, "w") as out:
-        launch = subprocess.Popen(command, stdout=out, stderr=subprocess.STDOUT, env=env,
-                                  start_new_session=True)
     lines_path = os.path.join(args.work, "platoon_reader_%d.jsonl" % n)
-    with open(lines_path, "w") as out:
-        reader = subprocess.Popen([sys.executable, "-c", READER], stdout=out,
-                                  stderr=subprocess.DEVNULL, env=env, start_new_session=True)
+    launch, reader = start_launch(command, env,
+                                  os.path.join(args.work, "platoon_launch_%d.log" % n), READER,
+                                  lines_path)
     result = {"n": n, "rate": args.rate, "window_s": args.window}
     try:
         deadline = time.time() + 60.0 + 1.0 * n
