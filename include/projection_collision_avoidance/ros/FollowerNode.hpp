@@ -58,8 +58,9 @@ struct Scenario;
 /// timer's expected time, or the measurement's stamp) and tick_delay (start - due time).
 ///
 /// ~control_loop decides what runs the fixed-rate tick. "timer" (default): on simulated time a
-/// ros::Timer on a callback queue served by a spinner thread of its own; on wall time a
-/// PeriodicThread without real-time priority (one wake-up per tick), publishing on that thread.
+/// ros::Timer on a callback queue served by a spinner thread of its own; on wall time the
+/// SharedTicker thread of its control rate (no real-time priority), which runs the ticks of every
+/// follower of the process at that rate in turn, each publishing on that thread.
 /// "thread": a PeriodicThread (RealtimeLoop.hpp) that sleeps with clock_nanosleep to absolute
 /// CLOCK_MONOTONIC deadlines k / control_rate from its start and runs the same tick at each,
 /// stamped with ros::Time::now(); refused under /use_sim_time. Its missed periods ("timer"
