@@ -24,9 +24,10 @@ namespace projection_collision_avoidance {
 /// up every tick that is due (at most one second of them per callback); scenario time is ROS
 /// time under use_sim_time and the time since the first tick otherwise; when ROS time goes back
 /// it waits for it to reach the next tick again. On wall time those ticks run on a thread of its
-/// own ("plant tick") sleeping to monotonic deadlines, one wake-up per tick. On wall time a backlog of more than 50 ms
-/// (a stall, or more agents than the plant can integrate at ~rate) is dropped and reported, the
-/// ticks after it stamped from the wall clock: stamps stay within 50 ms of the senders' clocks.
+/// own ("plant tick") sleeping to monotonic deadlines, one wake-up per tick. On wall time a backlog
+/// of more than 50 ms (a stall, or more agents than the plant can integrate at ~rate) is dropped
+/// and reported, the ticks after it stamped from the wall clock: stamps stay within 50 ms of the
+/// senders' clocks.
 ///
 /// Holding simulated time (publish_clock only): with ~wait_for_followers it stays at its start
 /// until every follower listens (or that many wall s have passed), and the wall schedule starts
