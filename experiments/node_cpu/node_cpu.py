@@ -66,15 +66,19 @@ def thread_ns(pid):
     return out
 
 
-def node_pids(launch_pid):
-    """{node executable: pid} among roslaunch's children (each node has a session of its own)."""
+def launch_children(launch_pid):
+    """The pids of roslaunch's child processes (none once it has ended)."""
     try:
         with open("/proc/%d/task/%d/children" % (launch_pid, launch_pid)) as f:
-            listing = f.read().split()
+            return [int(p) for p in f.read().split()]
     except OSError:
-        return {}
+        return []
+
+
+def node_pids(launch_pid):
+    """{node executable: pid} among roslaunch's children (each node has a session of its own)."""
     pids = {}
-    for pid in map(int, listing):
+    for pid in launch_children(launch_pid):
         try:
             with open("/proc/%d/cmdline" % pid, "rb") as f:
                 exe = os.path.basename(f.read().split(b"\0")[0].decode())

@@ -25,7 +25,7 @@ import time
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "common"))
 sys.path.insert(0, HERE)
-from node_cpu import cpu_jiffies, start_launch, thread_ns  # noqa: E402
+from node_cpu import cpu_jiffies, launch_children, start_launch, thread_ns  # noqa: E402
 from process_control import stop as stop_process  # noqa: E402
 
 SCENARIO = os.path.join(HERE, "..", "..", "config", "scenarios", "paper_run2.yaml")
@@ -57,12 +57,7 @@ rospy.spin()
 
 def manager_pid(launch_pid):
     """The nodelet manager among roslaunch's children (None before it runs)."""
-    try:
-        with open("/proc/%d/task/%d/children" % (launch_pid, launch_pid)) as f:
-            children = [int(p) for p in f.read().split()]
-    except OSError:
-        return None
-    for pid in children:
+    for pid in launch_children(launch_pid):
         try:
             with open("/proc/%d/cmdline" % pid, "rb") as f:
                 args = f.read().split(b"\0")
@@ -71,14 +66,6 @@ def manager_pid(launch_pid):
         if b"manager" in args and any(a == b"__name:=formation_manager" for a in args):
             return pid
     return None
-
-
-def launch_children(launch_pid):
-    try:
-        with open("/proc/%d/task/%d/children" % (launch_pid, launch_pid)) as f:
-            return [int(p) for p in f.read().split()]
-    except OSError:
-        return []
 
 
 def total_jiffies(pids):
