@@ -34,8 +34,8 @@ LeaderNode::LeaderNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   echoScenario(name_, private_nh);
   reader.echo(name_);
 
-  command_publisher_ = nh_.advertise<geometry_msgs::AccelStamped>("leader/command", 10);
-  broadcast_publisher_ = nh_.advertise<LeaderBroadcast>("leader/broadcast", 10);
+  command_publisher_.advertise<geometry_msgs::AccelStamped>(nh_, "leader/command", 10);
+  broadcast_publisher_.advertise<LeaderBroadcast>(nh_, "leader/broadcast", 10);
   odometry_subscriber_ = nh_.subscribe("leader/odom", 10, &LeaderNode::onOdometry, this,
                                        ros::TransportHints().tcpNoDelay());
   timer_ = nh_.createTimer(ros::Duration(1.0 / options_.rate), &LeaderNode::onTick, this);
@@ -102,6 +102,9 @@ void LeaderNode::onTick(const ros::TimerEvent& event) {
     return;  // one broadcast per odometry: its stamp is the odometry's, and a repeat is refused
   }
   odometry_fresh_ = false;
+  if (!broadcast_publisher_.subscribed()) {
+    return;
+  }
   auto broadcast = boost::make_shared<LeaderBroadcast>();
   broadcast->header = odometry_.header;
   broadcast->position = toStdVector(state_.head(axes_));

@@ -37,7 +37,7 @@ std::int64_t monotonicNanoseconds() {
 PeriodicThread::~PeriodicThread() { stop(); }
 
 void PeriodicThread::start(std::chrono::nanoseconds period, int priority, Callback callback,
-                           const std::string& name) {
+                           const std::string& name, std::chrono::nanoseconds phase) {
   if (period.count() <= 0) {
     throw std::invalid_argument("PeriodicThread: the period must be positive, got " +
                                 std::to_string(period.count()) + " ns");
@@ -46,6 +46,11 @@ void PeriodicThread::start(std::chrono::nanoseconds period, int priority, Callba
     throw std::invalid_argument("PeriodicThread: the priority must lie in [0, " +
                                 std::to_string(kMaxPriority) + "], got " +
                                 std::to_string(priority));
+  }
+  if (phase != kFromNow && (phase.count() < 0 || phase >= period)) {
+    throw std::invalid_argument(
+        "PeriodicThread: the phase must lie in [0, period = " + std::to_string(period.count()) +
+        " ns), got " + std::to_string(phase.count()) + " ns");
   }
   if (!callback) {
     throw std::invalid_argument("PeriodicThread: no callback");
@@ -57,9 +62,9 @@ void PeriodicThread::start(std::chrono::nanoseconds period, int priority, Callba
   missed_.store(0, std::memory_order_relaxed);
   std::promise<int> started;
   std::future<int> outcome = started.get_future();
-  thread_ =
-      std::thread(&PeriodicThread::run, this, static_cast<std::int64_t>(period.count()), priority,
-                  std::move(callback), name.substr(0, kMaxNameLength), std::move(started));
+  thread_ = std::thread(&PeriodicThread::run, this, static_cast<std::int64_t>(period.count()),
+                        static_cast<std::int64_t>(phase.count()), priority, std::move(callback),
+                        name.substr(0, kMaxNameLength), std::move(started));
   const int error = outcome.get();
   if (error != 0) {
     thread_.join();  // it has returned already
@@ -76,8 +81,9 @@ void PeriodicThread::stop() {
   thread_.join();
 }
 
-void PeriodicThread::run(std::int64_t period, int priority, const Callback& callback,
-                         const std::string& name, std::promise<int> started) {
+void PeriodicThread::run(std::int64_t period, std::int64_t phase, int priority,
+                         const Callback& callback, const std::string& name,
+                         std::promise<int> started) {
   if (!name.empty()) {
     pthread_setname_np(pthread_self(), name.c_str());  // only fails for a name too long
   }
@@ -90,7 +96,10 @@ void PeriodicThread::run(std::int64_t period, int priority, const Callback& call
       return;
     }
   }
-  const std::int64_t start = monotonicNanoseconds();
+  std::int64_t start = monotonicNanoseconds();
+  if (phase >= 0) {  // the last time phase + j * period not after now
+    start -= ((start - phase) % period + period) % period;
+  }
   started.set_value(0);
   PeriodicTick tick;
   tick.period = period;

@@ -27,8 +27,10 @@ class SharedTickerGroup {
     return members_.size();
   }
   void start(std::chrono::nanoseconds period, const std::string& name) {
+    // On the grid k * period (phase 0): another thread of the process can keep clear of it.
     thread_.start(
-        period, 0, [this](const PeriodicTick& tick) { round(tick); }, name);
+        period, 0, [this](const PeriodicTick& tick) { round(tick); }, name,
+        std::chrono::nanoseconds(0));
   }
   std::uint64_t missed() const { return thread_.missedPeriods(); }
 

@@ -32,6 +32,7 @@ import rospkg
 import rospy
 import rostest
 import yaml
+from ros_test_helpers import node_executable
 
 PACKAGE = "projection_collision_avoidance"
 DEADLINE = 10.0  # wall seconds for a node to give up on a bad parameter (or to start)
@@ -47,15 +48,6 @@ RUNNING = {
 }
 NAN, INF = math.nan, math.inf
 MISSING = object()  # the ~scenario parameter is not set at all
-
-
-def node_executable(name):
-    """The node binary in the devel space or install space that rostest runs from."""
-    for prefix in os.environ.get("CMAKE_PREFIX_PATH", "").split(os.pathsep):
-        candidate = os.path.join(prefix, "lib", PACKAGE, name)
-        if prefix and os.access(candidate, os.X_OK):
-            return candidate
-    raise RuntimeError(f"{name} not found under CMAKE_PREFIX_PATH")
 
 
 @functools.lru_cache(maxsize=None)

@@ -145,6 +145,27 @@ TEST(PeriodicThread, CallsAtAbsoluteDeadlinesOfThePeriod) {
   EXPECT_EQ(recorder.ticks().size(), after_stop);
 }
 
+TEST(PeriodicThread, APhasePutsTheDeadlinesOnItsGrid) {
+  const std::int64_t period = 10 * 1000 * 1000;
+  const std::int64_t phase = 3 * 1000 * 1000;
+  Recorder recorder;
+  PeriodicThread thread;
+  const std::int64_t started = monotonicNanoseconds();
+  thread.start(nanoseconds(period), 0, recorder.callback(), "phased", nanoseconds(phase));
+  ASSERT_TRUE(recorder.waitFor(10));
+  thread.stop();
+  const std::vector<PeriodicTick> ticks = recorder.ticks();
+  expectSchedule(ticks, period);
+  for (const PeriodicTick& tick : ticks) {
+    EXPECT_EQ(tick.expected % period, phase) << "deadline " << tick.index << " off the grid";
+  }
+  // The first deadline is the first point of the grid after start().
+  EXPECT_GT(ticks.front().expected - static_cast<std::int64_t>(ticks.front().index - 1) * period,
+            started);
+  EXPECT_LE(ticks.front().expected - static_cast<std::int64_t>(ticks.front().index - 1) * period,
+            started + period);
+}
+
 TEST(PeriodicThread, OverrunsSkipTheDeadlinesAlreadyPast) {
   // Every 5th call takes 2.5 periods: the two deadlines that pass meanwhile are skipped (more if
   // the machine delays the thread further), and the next call says so.
@@ -245,6 +266,10 @@ TEST(PeriodicThread, RefusesBadArguments) {
   EXPECT_THROW(thread.start(milliseconds(1), -1, recorder.callback()), std::invalid_argument);
   EXPECT_THROW(thread.start(milliseconds(1), 100, recorder.callback()), std::invalid_argument);
   EXPECT_THROW(thread.start(milliseconds(1), 0, PeriodicThread::Callback()), std::invalid_argument);
+  EXPECT_THROW(thread.start(milliseconds(1), 0, recorder.callback(), "", milliseconds(1)),
+               std::invalid_argument);
+  EXPECT_THROW(thread.start(milliseconds(1), 0, recorder.callback(), "", nanoseconds(-2)),
+               std::invalid_argument);
   EXPECT_FALSE(thread.running());
   thread.start(milliseconds(5), 0, recorder.callback());
   EXPECT_THROW(thread.start(milliseconds(5), 0, recorder.callback()), std::logic_error);

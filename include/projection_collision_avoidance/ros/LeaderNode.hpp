@@ -7,6 +7,7 @@
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
 
+#include "projection_collision_avoidance/ros/CountedPublisher.hpp"
 #include "projection_collision_avoidance/ros/InputAdmission.hpp"
 #include "projection_collision_avoidance/ros/InputGuard.hpp"
 #include "projection_collision_avoidance/sim/Scenario.hpp"
@@ -55,8 +56,8 @@ class LeaderNode {
   ros::Time origin_;      ///< ROS time of scenario time 0
   ros::Time last_stamp_;  ///< of the last tick published
 
-  ros::Publisher command_publisher_;
-  ros::Publisher broadcast_publisher_;
+  CountedPublisher command_publisher_;
+  CountedPublisher broadcast_publisher_;
   ros::Subscriber odometry_subscriber_;
   ros::Timer timer_;
 };

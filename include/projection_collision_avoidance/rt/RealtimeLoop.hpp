@@ -57,7 +57,9 @@ class PeriodicThread {
   PeriodicThread(PeriodicThread&&) = delete;
   PeriodicThread& operator=(PeriodicThread&&) = delete;
 
-  /// Starts the thread: deadlines every @p period from now.
+  /// Starts the thread: deadlines every @p period from now, or, with a @p phase, at the times
+  /// phase + k * period of CLOCK_MONOTONIC, so that threads of one period started with
+  /// different phases keep that offset between their deadlines (their work does not collide).
   /// @param period    > 0
   /// @param priority  0: the thread keeps the scheduling policy and priority of the caller;
   ///                  1 to 99: SCHED_FIFO at that priority (pthread_setschedparam), set by the
@@ -65,12 +67,17 @@ class PeriodicThread {
   /// @param callback  what to run at each deadline
   /// @param name      the thread's name as ps and /proc/<pid>/task/<tid>/comm show it (at most
   ///                  15 characters are kept); empty: the caller's
-  /// @throws std::invalid_argument for a period <= 0, a priority outside [0, 99] or no callback
+  /// @param phase     in [0, period): deadlines on that grid; kFromNow (default): from now
+  /// @throws std::invalid_argument for a period <= 0, a priority outside [0, 99], a phase
+  ///         outside [0, period) or no callback
   /// @throws std::logic_error when the thread already runs
   /// @throws PriorityRefused when the priority is refused; the thread has then ended
   /// @throws std::system_error when no thread can be created
   void start(std::chrono::nanoseconds period, int priority, Callback callback,
-             const std::string& name = std::string());
+             const std::string& name = std::string(), std::chrono::nanoseconds phase = kFromNow);
+
+  /// start()'s phase for deadlines every period from the start.
+  static constexpr std::chrono::nanoseconds kFromNow{-1};
 
   /// Asks the thread to end and joins it; returns once it has ended. Does nothing when it does
   /// not run. Not to be called from the callback.
@@ -88,8 +95,8 @@ class PeriodicThread {
  private:
   /// The thread's body: sets the priority, reports the outcome to start() through @p started
   /// (0 or the errno), then loops until stop().
-  void run(std::int64_t period, int priority, const Callback& callback, const std::string& name,
-           std::promise<int> started);
+  void run(std::int64_t period, std::int64_t phase, int priority, const Callback& callback,
+           const std::string& name, std::promise<int> started);
   /// Sleeps until @p deadline (monotonic ns) in slices; false when asked to stop meanwhile.
   bool sleepUntil(std::int64_t deadline) const;
 

@@ -20,7 +20,8 @@ class SharedTickerGroup;
 /// A member's place in the group of its period. Its call runs at every deadline of the group's
 /// PeriodicThread (no real-time priority), after the calls of the members that joined before it,
 /// with PeriodicTick::actual the time its own call starts (so a member's delay counts the calls
-/// before it) and the group's deadline, index and skipped deadlines. Destroying it leaves the
+/// before it) and the group's deadline, index and skipped deadlines. The deadlines lie on the
+/// grid k * period of CLOCK_MONOTONIC (PeriodicThread's phase 0). Destroying it leaves the
 /// group: it waits for a running round, and its call is not made again. The group's thread ends
 /// when its last member leaves.
 class SharedTicker {

@@ -28,10 +28,10 @@ FollowerOutputs::FollowerOutputs(ros::NodeHandle nh, ros::NodeHandle private_nh,
       separation_(separation),
       inputs_(inputs),
       diagnostics_(nh, private_nh) {
-  command_publisher_ = nh.advertise<geometry_msgs::AccelStamped>("command", 10);
-  broadcast_publisher_ = nh.advertise<LeaderBroadcast>("broadcast", 10);
-  status_publisher_ = nh.advertise<FollowerStatus>("status", 10);
-  marker_publisher_ = nh.advertise<visualization_msgs::MarkerArray>("markers", 2);
+  command_publisher_.advertise<geometry_msgs::AccelStamped>(nh, "command", 10);
+  broadcast_publisher_.advertise<LeaderBroadcast>(nh, "broadcast", 10);
+  status_publisher_.advertise<FollowerStatus>(nh, "status", 10);
+  marker_publisher_.advertise<visualization_msgs::MarkerArray>(nh, "markers", 2);
   diagnostics_.setHardwareID(options_.follower_frame);
   diagnostics_.add("follower controller", this, &FollowerOutputs::diagnose);
   // Markers every control_rate / marker_rate steps, statuses every control_rate / status_rate.
@@ -79,7 +79,7 @@ void FollowerOutputs::publish(const FollowerCycleOutput& out) {
     command_publisher_.publish(boost::make_shared<geometry_msgs::AccelStamped>(
         toAccelMsg(out.status.command, stamp, options_.follower_frame)));
     // The other messages are made only while someone subscribes to them.
-    if (broadcast_publisher_.getNumSubscribers() > 0) {
+    if (broadcast_publisher_.subscribed()) {
       auto broadcast = boost::make_shared<LeaderBroadcast>();  // its acceleration, no state
       broadcast->header.stamp = stamp;
       broadcast->header.frame_id = options_.follower_frame;
@@ -89,14 +89,14 @@ void FollowerOutputs::publish(const FollowerCycleOutput& out) {
     // Every so many steps, and at every change of mode (a fallback is never left out).
     if (steps_per_status_ > 0 &&
         ((out.steps - 1) % steps_per_status_ == 0 || out.mode != status_mode_)) {
-      if (status_publisher_.getNumSubscribers() > 0) {
+      if (status_publisher_.subscribed()) {
         status_publisher_.publish(boost::make_shared<FollowerStatus>(
             toStatusMsg(out, inputs_->stats(out.now_ns), member_, options_.follower_frame)));
       }
       status_mode_ = out.mode;
     }
     if (steps_per_marker_ > 0 && (out.steps - 1) % steps_per_marker_ == 0 &&
-        marker_publisher_.getNumSubscribers() > 0) {
+        marker_publisher_.subscribed()) {
       publishMarkers(out);
     }
   }

@@ -13,6 +13,7 @@
 
 #include "projection_collision_avoidance/core/Formation.hpp"
 #include "projection_collision_avoidance/node/FollowerCycle.hpp"
+#include "projection_collision_avoidance/ros/CountedPublisher.hpp"
 #include "projection_collision_avoidance/rt/Handoff.hpp"
 
 #include "follower/FollowerInputs.hpp"
@@ -89,10 +90,10 @@ class FollowerOutputs {
   std::mutex gain_mutex_;  ///< tracker_gain_: set by reconfiguration
   std::string tracker_gain_;
 
-  ros::Publisher command_publisher_;
-  ros::Publisher broadcast_publisher_;
-  ros::Publisher status_publisher_;
-  ros::Publisher marker_publisher_;
+  CountedPublisher command_publisher_;
+  CountedPublisher broadcast_publisher_;
+  CountedPublisher status_publisher_;
+  CountedPublisher marker_publisher_;
   diagnostic_updater::Updater diagnostics_;
 
   Handoff<FollowerCycleOutput, kQueueCapacity> handoff_;

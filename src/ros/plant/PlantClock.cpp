@@ -33,20 +33,30 @@ PlantClock::PlantClock(ros::NodeHandle nh, std::string node_name, const PlantNod
     wall_timer_ =
         nh.createWallTimer(ros::WallDuration(1.0 / (options_.rate * options_.real_time_factor)),
                            &PlantClock::onWallTick, this);
-  } else if (ros::Time::isSimTime()) {
+  } else if (!ticksOnThread(options_)) {
     timer_ = nh.createTimer(ros::Duration(1.0 / options_.rate), &PlantClock::onRosTick, this);
   } else {
+    // Half a period off the followers' shared ticks at the same rate (on the grid k * period):
+    // in one process the plant's tick and their round do not contend for roscpp's locks.
+    const std::chrono::nanoseconds period(std::llround(1e9 / options_.rate));
     thread_.start(
-        std::chrono::nanoseconds(std::llround(1e9 / options_.rate)), 0,
-        [this](const PeriodicTick& tick) { onThreadTick(tick); }, "plant tick");
+        period, 0, [this](const PeriodicTick& tick) { onThreadTick(tick); }, "plant tick",
+        period / 2);
   }
 }
 
 PlantClock::~PlantClock() { thread_.stop(); }
 
+bool PlantClock::ticksOnThread(const PlantNodeOptions& options) {
+  return !options.publish_clock && !ros::Time::isSimTime();
+}
+
 void PlantClock::onThreadTick(const PeriodicTick& tick) {
   if (!ros::ok()) {  // shutting down: a timer's callback would not run either
     return;
+  }
+  if (hooks_.before_tick) {
+    hooks_.before_tick();
   }
   const std::lock_guard<std::mutex> lock(*mutex_);
   try {

@@ -49,7 +49,14 @@ class PlantClock {
     std::function<std::pair<int, int>()> listening;
     /// ~lockstep: whether every agent that has commanded answered tick k.
     std::function<bool(long k)> answered;
+    /// On wall time (ticksOnThread()): runs on the tick thread before each tick, without the
+    /// mutex (the commands received since the tick before). May be empty.
+    std::function<void()> before_tick;
   };
+
+  /// Whether the plant ticks on a thread of its own (wall time, not publishing /clock) rather
+  /// than on a timer of @p options' node handle.
+  static bool ticksOnThread(const PlantNodeOptions& options);
 
   /// Starts the timers. Every callback runs under @p mutex.
   PlantClock(ros::NodeHandle nh, std::string node_name, const PlantNodeOptions& options,

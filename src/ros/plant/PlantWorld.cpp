@@ -82,8 +82,8 @@ PlantWorld::PlantWorld(ros::NodeHandle nh, ros::NodeHandle private_nh)
   for (Follower& follower : followers_) {
     attachVehicle(&follower.agent);
     connectAgent(&follower.agent);
-    follower.measurement_publisher =
-        nh_.advertise<RelativeMeasurement>(follower.agent.name + "/relative_measurement", 10);
+    follower.measurement_publisher.advertise<RelativeMeasurement>(
+        nh_, follower.agent.name + "/relative_measurement", 10);
   }
   marker_publisher_ = nh_.advertise<visualization_msgs::MarkerArray>("agent_markers", 2);
   ticks_per_marker_ = std::max(1L, static_cast<long>(std::ceil(options_.rate / kMarkerRate)));
@@ -123,14 +123,14 @@ PlantWorld::PlantWorld(ros::NodeHandle nh, ros::NodeHandle private_nh)
     for (const Follower& follower : followers_) {
       // A vehicle's follower listens to odometry and drives it through cmd_vel.
       const PlantVehicle* vehicle = follower.agent.vehicle.get();
-      const bool listens = vehicle != nullptr
-                               ? vehicle->driven()
-                               : follower.measurement_publisher.getNumSubscribers() > 0;
+      const bool listens =
+          vehicle != nullptr ? vehicle->driven() : follower.measurement_publisher.subscribed();
       listening += listens ? 1 : 0;
     }
     return std::make_pair(listening, static_cast<int>(followers_.size()));
   };
   hooks.answered = [this](long k) { return commandsAnswer(k); };
+  hooks.before_tick = [this] { command_queue_.callAvailable(); };
   clock_ = std::make_unique<PlantClock>(nh_, name_, options_, &mutex_, std::move(hooks));
   std::ostringstream summary;
   summary << name_ << ": simulating a leader and " << followers_.size() << " follower(s)";
@@ -173,13 +173,18 @@ void PlantWorld::connectAgent(Agent* agent) {
     }
     return;
   }
-  agent->odom_publisher = nh_.advertise<nav_msgs::Odometry>(agent->name + "/odom", 10);
-  agent->applied_command_publisher =
-      nh_.advertise<geometry_msgs::AccelStamped>(agent->name + "/applied_command", 10);
-  agent->command_subscriber = nh_.subscribe<geometry_msgs::AccelStamped>(
+  agent->odom_publisher.advertise<nav_msgs::Odometry>(nh_, agent->name + "/odom", 10);
+  agent->applied_command_publisher.advertise<geometry_msgs::AccelStamped>(
+      nh_, agent->name + "/applied_command", 10);
+  ros::SubscribeOptions subscription;
+  subscription.init<geometry_msgs::AccelStamped>(
       agent->name + "/command", 10,
-      [this, agent](const geometry_msgs::AccelStamped::ConstPtr& msg) { onCommand(agent, msg); },
-      ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
+      [this, agent](const geometry_msgs::AccelStamped::ConstPtr& msg) { onCommand(agent, msg); });
+  subscription.transport_hints = ros::TransportHints().tcpNoDelay();
+  if (PlantClock::ticksOnThread(options_)) {
+    subscription.callback_queue = &command_queue_;
+  }
+  agent->command_subscriber = nh_.subscribe(subscription);
 }
 
 void PlantWorld::onCommand(Agent* agent, const geometry_msgs::AccelStamped::ConstPtr& msg) {
@@ -259,8 +264,10 @@ void PlantWorld::sampleAgent(Agent* agent, const ros::Time& stamp,
   }
   const Eigen::VectorXd state = agent->integrator.state();
   // Shared pointers: a subscriber in the same process (nodelets) gets the message itself.
-  agent->odom_publisher.publish(boost::make_shared<nav_msgs::Odometry>(
-      toOdometryMsg(state, stamp, options_.world_frame, agent->frame)));
+  if (agent->odom_publisher.subscribed()) {
+    agent->odom_publisher.publish(boost::make_shared<nav_msgs::Odometry>(
+        toOdometryMsg(state, stamp, options_.world_frame, agent->frame)));
+  }
   transforms->push_back(
       toTransformMsg(state.head(axes_), stamp, options_.world_frame, agent->frame));
 }
@@ -290,7 +297,7 @@ void PlantWorld::advanceAgent(Agent* agent, double t, const ros::Time& stamp) {
     return;
   }
   const GenericDimensions::InputVector command = commandAt(agent, stamp);
-  if (agent->applied_command_publisher.getNumSubscribers() > 0) {
+  if (agent->applied_command_publisher.subscribed()) {
     agent->applied_command_publisher.publish(
         boost::make_shared<geometry_msgs::AccelStamped>(toAccelMsg(command, stamp, agent->frame)));
   }

@@ -7,11 +7,13 @@
 
 #include <Eigen/Core>
 #include <geometry_msgs/AccelStamped.h>
+#include <ros/callback_queue.h>
 #include <ros/ros.h>
 #include <tf2_ros/static_transform_broadcaster.h>
 #include <tf2_ros/transform_broadcaster.h>
 
 #include "projection_collision_avoidance/RelativeMeasurement.h"
+#include "projection_collision_avoidance/ros/CountedPublisher.hpp"
 #include "projection_collision_avoidance/ros/InputAdmission.hpp"
 #include "projection_collision_avoidance/ros/InputGuard.hpp"
 #include "projection_collision_avoidance/ros/RosParameters.hpp"
@@ -78,9 +80,9 @@ class PlantWorld {
     std::int64_t command_stamp = 0;
     bool command_timed_out = false;  ///< the last tick used zero for lack of a fresh command
     ros::Subscriber command_subscriber;
-    ros::Publisher odom_publisher;
-    ros::Publisher applied_command_publisher;  ///< the command integrated over each tick
-    std::unique_ptr<PlantVehicle> vehicle;     ///< a vehicle kind; null: the double integrator
+    CountedPublisher odom_publisher;
+    CountedPublisher applied_command_publisher;  ///< the command integrated over each tick
+    std::unique_ptr<PlantVehicle> vehicle;       ///< a vehicle kind; null: the double integrator
 
     /// [p; v] of the agent (2 axes entries).
     Eigen::VectorXd state() const {
@@ -92,7 +94,7 @@ class PlantWorld {
   struct Follower {
     Agent agent;
     int target = 0;  ///< 0: the leader; j: followers_[j - 1]
-    ros::Publisher measurement_publisher;
+    CountedPublisher measurement_publisher;
   };
 
   /// Makes @p agent the vehicle ~vehicles asks for, if any (from its initial state).
@@ -130,6 +132,9 @@ class PlantWorld {
   PlantNodeOptions options_;
   int axes_;
 
+  /// On wall time, the commands' callbacks: the tick thread calls them before each tick, so that
+  /// a command wakes no thread (a follower in the same process publishes it and goes on).
+  ros::CallbackQueue command_queue_;
   std::mutex mutex_;  ///< guards everything below against concurrent callbacks (nodelets)
   Agent leader_;
   std::vector<Follower> followers_;  ///< in index order; never resized after the subscriptions
