@@ -79,11 +79,12 @@ def total_jiffies(pids):
 
 
 def machine_jiffies():
-    """(busy, all) clock ticks of every core, from /proc/stat."""
+    """(busy, all, steal) clock ticks of every core, from /proc/stat. Steal: time the hypervisor
+    kept this VM's cores from running (counted in busy)."""
     with open("/proc/stat") as f:
         fields = [int(x) for x in f.readline().split()[1:]]
     idle = fields[3] + fields[4]
-    return sum(fields) - idle, sum(fields)
+    return sum(fields) - idle, sum(fields), fields[7]
 
 
 def read_lines(path):
@@ -177,6 +178,7 @@ def measure(args, n):
         "loaders_percent": 100.0 * (others1 - others0) / os.sysconf("SC_CLK_TCK") / window,
         "loaders": len(others),
         "machine_busy_percent": 100.0 * (busy1[0] - busy0[0]) / max(1, busy1[1] - busy0[1]),
+        "steal_percent": 100.0 * (busy1[2] - busy0[2]) / max(1, busy1[1] - busy0[1]),
         "most_missed": sorted(worst, reverse=True)[:5],
     })
     result["holds"] = (len(rates) == n and result["min_rate"] >= 0.99 * args.rate and
@@ -193,12 +195,13 @@ def command_run(args):
             print("N=%3d  manager %6.1f %% (stat %6.1f %%)  follower tick %6.1f us (%.3f %% each)"
                   "  plant %5.1f us per agent  other %5.1f us per follower tick  min rate %.2f Hz"
                   "  max late %.2f %%  tracking %d/%d  plant drops %d  loaders %.1f %%"
-                  "  machine busy %.0f %%  most missed %s  holds %s" % (
+                  "  machine busy %.0f %% (steal %.1f %%)  most missed %s  holds %s" % (
                       n, r["manager_percent_sched"], r["manager_percent_stat"],
                       r["follower_tick_us"], r["follower_percent"], r["plant_agent_us"],
                       r["other_us_per_follower_tick"], r["min_rate"], 100 * r["max_late"],
                       r["tracking"], n, r["plant_drops"], r["loaders_percent"],
-                      r["machine_busy_percent"], r["most_missed"][:3], r["holds"]), flush=True)
+                      r["machine_busy_percent"], r["steal_percent"], r["most_missed"][:3],
+                      r["holds"]), flush=True)
 
 
 def command_report(args):
@@ -207,7 +210,7 @@ def command_report(args):
               "other threads (%)", "us per follower tick", "us per plant agent and tick",
               "other threads per follower tick (us)", "min follower rate (Hz)",
               "max late ticks (%)", "most missed periods", "tracking", "plant drops",
-              "nodelet loaders (% of a core)", "machine busy (%)", "holds"]
+              "nodelet loaders (% of a core)", "machine busy (%)", "steal (%)", "holds"]
     with open(args.csv, "w") as out:
         out.write(",".join(header) + "\n")
         for r in rows:
@@ -221,6 +224,7 @@ def command_report(args):
                 "%d/%d" % (r["tracking"], r["n"]), r["plant_drops"],
                 "%.1f" % r["loaders_percent"] if "loaders_percent" in r else "",
                 "%.0f" % r["machine_busy_percent"] if "machine_busy_percent" in r else "",
+                "%.1f" % r["steal_percent"] if "steal_percent" in r else "",
                 "yes" if r["holds"] else "no"]) + "\n")
     import matplotlib
     matplotlib.use("Agg")
