@@ -3,16 +3,17 @@
 #   1. builds this checkout (build/) and the commit before the ROS-layer changes (BEFORE, default
 #      4aa92ef, checked out with `git worktree` into $WORK/before and built there);
 #   2. follower_node, plant_node and leader_node CPU per tick, before and after, at 100 Hz and
-#      1 kHz (run.sh) -> doc/node_cpu.csv, and the follower with ~trigger measurement ->
-#      doc/node_cpu_trigger.csv;
+#      1 kHz (run.sh) -> doc/node_cpu.csv, and this build's follower with ~trigger timer and
+#      measurement -> doc/node_cpu_trigger.csv;
 #   3. instructions per tick of each part, before and after (callgrind.sh) ->
 #      doc/performance_data/callgrind_{before,after}.txt;
 #   4. the platoon in one nodelet manager against N (platoon_cpu.py) -> doc/platoon_cpu.csv and
-#      doc/platoon_cpu.png, raw in doc/performance_data/platoon_cpu.jsonl.
+#      doc/platoon_cpu.png, raw in doc/performance_data/platoon_cpu.jsonl; then N = 128 four times
+#      -> doc/platoon_cpu_128_repeats.csv.
 # Usage: experiments/node_cpu/all.sh   (BEFORE, WORK (default /tmp/node_cpu), WINDOW (s, default
-#   20), SIZES (default "1 8 32 64 128 160"), SKIP_BEFORE=1 measures this build alone)
-# Takes about 45 min on this 2-core machine: 12 to build BEFORE (with SKIP_BEFORE=1, none),
-# 6 for step 2, 3 for step 3, 12 for step 4 (plus building this checkout if it is not built).
+#   20), SIZES (default "1 8 32 64 96 128 160"), SKIP_BEFORE=1 measures this build alone)
+# Takes about 50 min on this 2-core machine: 12 to build BEFORE (with SKIP_BEFORE=1, none),
+# 8 for step 2, 3 for step 3, 17 for step 4 (plus building this checkout if it is not built).
 # Timing-sensitive: run it on an otherwise idle machine.
 set -euo pipefail
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
@@ -20,7 +21,7 @@ root=$(cd "$here/../.." && pwd)
 before=${BEFORE:-4aa92ef}
 work=${WORK:-/tmp/node_cpu}
 window=${WINDOW:-20}
-read -r -a sizes <<<"${SIZES:-1 8 32 64 128 160}"
+read -r -a sizes <<<"${SIZES:-1 8 32 64 96 128 160}"
 data=$root/doc/performance_data
 mkdir -p "$work" "$data"
 start=$(date +%s)
@@ -46,8 +47,10 @@ RUNS=1 WINDOW=$window OUT=$root/doc/node_cpu.csv bash "$here/run.sh" "${builds[@
   source "$root/build/devel/setup.bash"
   set -u
   rm -f "$work/trigger.jsonl"
+  /usr/bin/python3 "$here/node_cpu.py" --label timer --window "$window" --json "$work/trigger.jsonl"
   /usr/bin/python3 "$here/node_cpu.py" --label "trigger measurement" --window "$window" \
     --launch-arg trigger:=measurement --json "$work/trigger.jsonl"
+  cp "$work/trigger.jsonl" "$data/node_cpu_trigger.jsonl"
   /usr/bin/python3 "$here/node_cpu.py" --report --json "$work/trigger.jsonl" \
     --csv "$root/doc/node_cpu_trigger.csv"
 )
@@ -63,11 +66,16 @@ step "4. the platoon against N = ${sizes[*]}"
   # shellcheck disable=SC1091
   source "$root/build/devel/setup.bash"
   set -u
-  rm -f "$data/platoon_cpu.jsonl"
+  rm -f "$data/platoon_cpu.jsonl" "$data/platoon_cpu_128_repeats.jsonl"
   /usr/bin/python3 "$here/platoon_cpu.py" run --sizes "${sizes[@]}" --window "$window" \
     --json "$data/platoon_cpu.jsonl" --work "$work"
   /usr/bin/python3 "$here/platoon_cpu.py" report --json "$data/platoon_cpu.jsonl" \
     --csv "$root/doc/platoon_cpu.csv" --png "$root/doc/platoon_cpu.png"
+  # N = 128 again, four times: how much it varies from run to run.
+  /usr/bin/python3 "$here/platoon_cpu.py" run --sizes 128 128 128 128 --window "$window" \
+    --json "$data/platoon_cpu_128_repeats.jsonl" --work "$work"
+  /usr/bin/python3 "$here/platoon_cpu.py" report --json "$data/platoon_cpu_128_repeats.jsonl" \
+    --csv "$root/doc/platoon_cpu_128_repeats.csv" --png "$work/platoon_cpu_128_repeats.png"
 )
 step "done: doc/node_cpu.csv, doc/node_cpu_trigger.csv, doc/performance_data/callgrind_*.txt," \
-  "doc/platoon_cpu.csv, doc/platoon_cpu.png"
+  "doc/platoon_cpu.csv, doc/platoon_cpu.png, doc/platoon_cpu_128_repeats.csv"
