@@ -23,7 +23,8 @@ source "$build/devel/setup.bash"
 set -u
 export ROS_MASTER_URI=http://localhost:11433
 prefix="valgrind --tool=callgrind --callgrind-out-file=$work/callgrind.out.%p --dump-instr=no"
-setsid roslaunch --port 11433 projection_collision_avoidance pair.launch \
+# This checkout's pair.launch (it has follower_prefix), the nodes of BUILD_DIR.
+setsid roslaunch --port 11433 "$root/launch/pair.launch" \
   scenario:="$root/config/scenarios/paper_run2.yaml" sim_time:=false control_rate:="$rate" \
   follower_prefix:="$prefix" >"$work/launch.log" 2>&1 &
 launch=$!
