@@ -56,6 +56,12 @@ void PlantClock::onThreadTick(const PeriodicTick& tick) {
     return;
   }
   if (hooks_.before_tick) {
+    {
+      // After a stall plant time moves up to the wall clock first: the commands queued meanwhile
+      // are stamped on it, and would be judged ahead of the stalled plant time.
+      const std::lock_guard<std::mutex> lock(*mutex_);
+      dropWallBacklogNow();
+    }
     hooks_.before_tick();
   }
   const std::lock_guard<std::mutex> lock(*mutex_);
@@ -232,6 +238,16 @@ void PlantClock::rosTick(const ros::Time& expected) {
   // Catch up every due tick, at most one second of them per call.
   runThrough(std::min(due, next_tick_ + std::max(1L, std::lround(options_.rate))),
              ros::WallTime::now());
+}
+
+void PlantClock::dropWallBacklogNow() {
+  const ros::Time now = ros::Time::now();
+  if (!started_ || !running_ || now.isZero()) {
+    return;
+  }
+  dropWallBacklog(
+      static_cast<long>(std::floor(secondsBetween(now, origin_) * options_.rate + kTickTolerance)),
+      now);
 }
 
 long PlantClock::dropWallBacklog(long due, const ros::Time& now) {

@@ -83,6 +83,8 @@ class PlantClock {
   /// Wall time: the last tick to run at ROS time @p now, given the tick @p due by the origin;
   /// a backlog of more than kMaxCatchUp s is dropped (the origin moved to now) and reported.
   long dropWallBacklog(long due, const ros::Time& now);
+  /// Wall time: dropWallBacklog() for the tick due now (nothing before the first tick).
+  void dropWallBacklogNow();
   /// Runs the ticks from next_tick_ through @p due while the plant runs (and, in lockstep, the
   /// commands answer), at wall time @p wall_now.
   void runThrough(long due, const ros::WallTime& wall_now);
