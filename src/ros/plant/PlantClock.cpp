@@ -227,8 +227,7 @@ void PlantClock::rosTick(const ros::Time& expected) {
       return;
     }
   }
-  long due =
-      static_cast<long>(std::floor(secondsBetween(now, origin_) * options_.rate + kTickTolerance));
+  long due = dueAt(now);
   if (due < next_tick_ - 1) {
     return;  // ROS time went back: wait for it to reach the next tick again
   }
@@ -245,9 +244,12 @@ void PlantClock::dropWallBacklogNow() {
   if (!started_ || !running_ || now.isZero()) {
     return;
   }
-  dropWallBacklog(
-      static_cast<long>(std::floor(secondsBetween(now, origin_) * options_.rate + kTickTolerance)),
-      now);
+  dropWallBacklog(dueAt(now), now);
+}
+
+long PlantClock::dueAt(const ros::Time& now) const {
+  return static_cast<long>(
+      std::floor(secondsBetween(now, origin_) * options_.rate + kTickTolerance));
 }
 
 long PlantClock::dropWallBacklog(long due, const ros::Time& now) {

@@ -85,6 +85,8 @@ class PlantClock {
   long dropWallBacklog(long due, const ros::Time& now);
   /// Wall time: dropWallBacklog() for the tick due now (nothing before the first tick).
   void dropWallBacklogNow();
+  /// The last tick due at ROS time @p now by the origin.
+  long dueAt(const ros::Time& now) const;
   /// Runs the ticks from next_tick_ through @p due while the plant runs (and, in lockstep, the
   /// commands answer), at wall time @p wall_now.
   void runThrough(long due, const ros::WallTime& wall_now);
