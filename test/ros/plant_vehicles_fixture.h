@@ -4,6 +4,7 @@
 /// The fixture of test_plant_vehicles: what it keeps of the plant's outputs (odometry, applied
 /// velocity commands, relative measurements), waiting on them, and the measurement check.
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <iterator>
@@ -198,13 +199,13 @@ class PlantVehiclesTest : public testing::RosTestFixture {
     return quiet;
   }
 
-  /// Stamp (s) of @p agent's first applied command after @p after (s) that is (not) zero.
-  double firstApplied(int agent, double after, bool zero) {
+  /// Stamp (s) of @p agent's first non-zero applied command after @p after (s).
+  double firstNonZeroApplied(int agent, double after) {
     double found = -1.0;
     EXPECT_TRUE(waitFor(
         [&] {
           for (const AppliedSample& a : records_[agent].applied) {
-            if (a.t > after && a.isZero() == zero) {
+            if (a.t > after && !a.isZero()) {
               found = a.t;
               return true;
             }
@@ -212,7 +213,28 @@ class PlantVehiclesTest : public testing::RosTestFixture {
           return false;
         },
         deadline_))
-        << kAgents[agent] << (zero ? ": no stop" : ": no command applied");
+        << kAgents[agent] << ": no command applied";
+    return found;
+  }
+
+  /// Stamp (s) of @p agent's stop once its commands have ended: the first zero applied command
+  /// after the last non-zero one. (A tick between a command's send and its receipt applies zero
+  /// too; that zero comes before the command's non-zero ones, so it is not the stop.)
+  double stopAfterLastMove(int agent) {
+    double found = -1.0;
+    EXPECT_TRUE(waitFor(
+        [&] {
+          const std::vector<AppliedSample>& a = records_[agent].applied;
+          const auto last_move = std::find_if(a.rbegin(), a.rend(),
+                                              [](const AppliedSample& s) { return !s.isZero(); });
+          if (last_move == a.rend() || last_move == a.rbegin()) {
+            return false;  // never moved, or still moving
+          }
+          found = last_move.base()->t;
+          return true;
+        },
+        deadline_))
+        << kAgents[agent] << ": no stop";
     return found;
   }
 

@@ -106,7 +106,7 @@ TEST_F(PlantVehiclesTest, VelocityVehicleFollowsItsBodyFrameCommandWithItsLag) {
   const double vc = param("velocity_command");
   const auto commands = stream(kVelocity, false);
   commands->set(twistOf(vc, 0.0, 0.0, 0.0, 0.0, 0.3));  // angular ignored
-  const double start = firstApplied(kVelocity, quiet, false);
+  const double start = firstNonZeroApplied(kVelocity, quiet);
   ASSERT_TRUE(waitForOdom(kVelocity, start + 6.0 * tau));
   const AgentRecord r = record(kVelocity);
   for (const AppliedSample& a : r.applied) {  // the body command turned into the world frame
@@ -137,7 +137,7 @@ TEST_F(PlantVehiclesTest, WorldFrameTwistsAreTakenAsTheyAreWithoutLag) {
   const double quiet = waitForStop(kWorldVelocity);
   const auto commands = stream(kWorldVelocity, false);
   commands->set(twistOf(command.x(), command.y(), 7.0, 0.0, 0.0, 1.0));  // z: beyond the 2 axes
-  const double start = firstApplied(kWorldVelocity, quiet, false);
+  const double start = firstNonZeroApplied(kWorldVelocity, quiet);
   ASSERT_TRUE(waitForOdom(kWorldVelocity, start + 0.5));
   const AgentRecord r = record(kWorldVelocity);
   for (const AppliedSample& a : r.applied) {
@@ -164,7 +164,7 @@ TEST_F(PlantVehiclesTest, UnicycleDrivesACircleOfRadiusVOverOmega) {
   const double quiet = waitForStop(kUnicycle);
   const auto commands = stream(kUnicycle, true);
   commands->set(twistOf(v, 5.0, -1.0, 3.0, 2.0, omega));  // only linear.x and angular.z count
-  const double start = firstApplied(kUnicycle, quiet, false);
+  const double start = firstNonZeroApplied(kUnicycle, quiet);
   const double from = start + param("settle_time");
   const double to = from + param("arc_time");
   ASSERT_TRUE(waitForOdom(kUnicycle, to));
@@ -220,12 +220,12 @@ TEST_F(PlantVehiclesTest, AStaleCommandStopsBothVehicles) {
   auto unicycle_commands = stream(kUnicycle, false);
   velocity_commands->set(twistOf(0.5, 0.0, 0.0, 0.0, 0.0, 0.0));
   unicycle_commands->set(twistOf(0.5, 0.0, 0.0, 0.0, 0.0, 0.0));
-  firstApplied(kVelocity, quiet[kVelocity], false);
-  firstApplied(kUnicycle, quiet[kUnicycle], false);
+  firstNonZeroApplied(kVelocity, quiet[kVelocity]);
+  firstNonZeroApplied(kUnicycle, quiet[kUnicycle]);
   const double last_sent[] = {0.0, velocity_commands->stop().toSec(),
                               unicycle_commands->stop().toSec()};
   for (const int agent : {kVelocity, kUnicycle}) {
-    const double stop = firstApplied(agent, last_sent[agent], true);
+    const double stop = stopAfterLastMove(agent);
     EXPECT_GE(stop - last_sent[agent], timeout - h - param("stale_lead")) << kAgents[agent];
     EXPECT_LE(stop - last_sent[agent], timeout + param("stale_slack")) << kAgents[agent];
     const double tau = param(agent == kVelocity ? "velocity_lag" : "unicycle_lag");
@@ -253,8 +253,8 @@ TEST_F(PlantVehiclesTest, NonFiniteTwistsAreRefusedWithoutEndingTheNode) {
   auto unicycle_bad = stream(kUnicycle, true);
   velocity_valid->set(twistOf(0.3, 0.0, 0.0, 0.0, 0.0, 0.0));
   unicycle_valid->set(twistOf(0.3, 0.0, 0.0, 0.0, 0.0, 0.2));
-  const double start = std::max(firstApplied(kVelocity, quiet[kVelocity], false),
-                                firstApplied(kUnicycle, quiet[kUnicycle], false));
+  const double start = std::max(firstNonZeroApplied(kVelocity, quiet[kVelocity]),
+                                firstNonZeroApplied(kUnicycle, quiet[kUnicycle]));
   const geometry_msgs::Twist bad[] = {twistOf(nan, 0, 0, 0, 0, 0), twistOf(0, 0, 0, inf, 0, 0),
                                       twistOf(0, -inf, 0, 0, 0, 0), twistOf(0, 0, 0, 0, 0, nan),
                                       twistOf(0, 0, nan, 0, nan, 0)};
