@@ -9,6 +9,9 @@ The follower's ticks over the window come from its diagnostics ("ticks"), which 
 anyway (1 Hz), so that the measurement adds no subscriber to the topics it times.
 
   node_cpu.py --rates 100 1000 --window 30 --json OUT.jsonl [--label L] [--launch-arg k:=v ...]
+  node_cpu.py --floor ...   the same with floor.launch: in the follower's place a bare roscpp relay
+                            (measurement_relay), one message in and one out per tick; its messages
+                            are counted by a subscriber on its output, at 1 Hz
   node_cpu.py --report --json OUT.jsonl --csv OUT.csv     (the table of every measurement)
 
 Prints one line per rate and node; writes one JSON line per rate to OUT.jsonl.
@@ -27,6 +30,7 @@ sys.path.insert(0, os.path.join(HERE, "..", "common"))
 from process_control import stop as stop_process  # noqa: E402
 
 NODES = ("follower_node", "plant_node", "leader_node")
+FLOOR_NODES = ("measurement_relay", "plant_node", "leader_node")
 SCENARIO = os.path.join(HERE, "..", "..", "config", "scenarios", "paper_run2.yaml")
 
 # Runs in its own interpreter with the launch's ROS_MASTER_URI: prints "stamp ticks" of each
@@ -42,6 +46,24 @@ def seen(msg):
 rospy.init_node("node_cpu_ticks", anonymous=True, disable_signals=True)
 rospy.Subscriber("/diagnostics", DiagnosticArray, seen, queue_size=100)
 rospy.spin()
+"""
+
+# The same output for floor.launch: "stamp count" of the relay's messages, once a second.
+RELAYED = r"""
+import sys, threading, rospy
+from projection_collision_avoidance.msg import RelativeMeasurement
+count = [0]
+lock = threading.Lock()
+def seen(msg):
+    with lock:
+        count[0] += 1
+rospy.init_node("node_cpu_relayed", anonymous=True, disable_signals=True)
+rospy.Subscriber("/follower/relay_output", RelativeMeasurement, seen, queue_size=1000,
+                 tcp_nodelay=True)
+while True:
+    rospy.sleep(1.0)
+    with lock:
+        print("%.6f %d" % (rospy.get_time(), count[0]), flush=True)
 """
 
 
@@ -75,8 +97,9 @@ def launch_children(launch_pid):
         return []
 
 
-def node_pids(launch_pid):
-    """{node executable: pid} among roslaunch's children (each node has a session of its own)."""
+def node_pids(launch_pid, nodes):
+    """{node executable: pid} of @p nodes among roslaunch's children (each node has a session of
+    its own)."""
     pids = {}
     for pid in launch_children(launch_pid):
         try:
@@ -84,7 +107,7 @@ def node_pids(launch_pid):
                 exe = os.path.basename(f.read().split(b"\0")[0].decode())
         except OSError:
             continue
-        if exe in NODES:
+        if exe in nodes:
             pids[exe] = pid
     return pids
 
@@ -115,20 +138,23 @@ def measure(args, rate):
     """One launch at @p rate Hz: the result dict."""
     env = dict(os.environ)
     env["ROS_MASTER_URI"] = "http://localhost:%d" % args.port
-    command = ["roslaunch", "--port", str(args.port), "projection_collision_avoidance",
-               "pair.launch", "scenario:=" + os.path.abspath(SCENARIO), "sim_time:=false",
-               "control_rate:=%g" % rate] + args.launch_arg
+    launch_file = (["projection_collision_avoidance", "pair.launch"] if not args.floor
+                   else [os.path.join(HERE, "floor.launch")])
+    nodes = FLOOR_NODES if args.floor else NODES
+    command = (["roslaunch", "--port", str(args.port)] + launch_file +
+               ["scenario:=" + os.path.abspath(SCENARIO), "sim_time:=false",
+                "control_rate:=%g" % rate] + args.launch_arg)
     ticks_log = os.path.join(args.work, "ticks_%g.txt" % rate)
     launch, reader = start_launch(command, env, os.path.join(args.work, "launch_%g.log" % rate),
-                                  TICKS, ticks_log)
+                                  RELAYED if args.floor else TICKS, ticks_log)
     try:
         deadline = time.time() + 60.0
         pids = {}
         while time.time() < deadline:  # every node running, the follower ticking
-            pids = node_pids(launch.pid)
+            pids = node_pids(launch.pid, nodes)
             with open(ticks_log) as f:
                 ticking = [t for t in read_ticks(f) if t[1] > 0]
-            if len(pids) == len(NODES) and len(ticking) >= 2:
+            if len(pids) == len(nodes) and len(ticking) >= 2:
                 break
             time.sleep(0.2)
         else:
@@ -211,6 +237,8 @@ def main():
     parser.add_argument("--report", action="store_true", help="only write --csv from --json")
     parser.add_argument("--csv", help="with --report: the table as CSV")
     parser.add_argument("--work", default="/tmp", help="directory of the ticks logs")
+    parser.add_argument("--floor", action="store_true",
+                        help="floor.launch: a bare roscpp relay in the follower's place")
     parser.add_argument("--launch-arg", action="append", default=[],
                         help="extra pair.launch argument k:=v (repeatable)")
     args = parser.parse_args()
@@ -228,7 +256,7 @@ def main():
                       "(stat %7.1f)  ticks at %.2f Hz" % (
                           rate, node, r["percent_core_sched"], r["percent_core_stat"],
                           r["us_per_tick_sched"], r["us_per_tick_stat"], result["tick_rate"]))
-            threads = result["nodes"]["follower_node"]["threads_s"]
+            threads = result["nodes"][(FLOOR_NODES if args.floor else NODES)[0]]["threads_s"]
             print("   follower threads (s of CPU over %.1f s): %s" % (
                 result["window_s"], ", ".join("%s %.3f" % kv for kv in threads.items())))
 
