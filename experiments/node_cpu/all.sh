@@ -4,16 +4,17 @@
 #      4aa92ef, checked out with `git worktree` into $WORK/before and built there);
 #   2. follower_node, plant_node and leader_node CPU per tick, before and after, at 100 Hz and
 #      1 kHz (run.sh) -> doc/node_cpu.csv, and this build's follower with ~trigger timer and
-#      measurement -> doc/node_cpu_trigger.csv;
+#      measurement, and a bare roscpp relay in its place (floor.launch) -> doc/node_cpu_trigger.csv;
 #   3. instructions per tick of each part, before and after (callgrind.sh) ->
 #      doc/performance_data/callgrind_{before,after}.txt;
 #   4. the platoon in one nodelet manager against N (platoon_cpu.py) -> doc/platoon_cpu.csv and
 #      doc/platoon_cpu.png, raw in doc/performance_data/platoon_cpu.jsonl; then N = 128 four times
 #      -> doc/platoon_cpu_128_repeats.csv.
 # Usage: experiments/node_cpu/all.sh   (BEFORE, WORK (default /tmp/node_cpu), WINDOW (s, default
-#   20), SIZES (default "1 8 32 64 96 128 160"), SKIP_BEFORE=1 measures this build alone)
-# Takes about 50 min on this 2-core machine: 12 to build BEFORE (with SKIP_BEFORE=1, none),
-# 8 for step 2, 3 for step 3, 17 for step 4 (plus building this checkout if it is not built).
+#   20), SIZES (default "1 8 32 64 96 128 160 192 224 256"), SKIP_BEFORE=1 measures this build
+#   alone)
+# Takes about 55 min on this 2-core machine: 12 to build BEFORE (with SKIP_BEFORE=1, none),
+# 10 for step 2, 3 for step 3, 20 for step 4 (plus building this checkout if it is not built).
 # Timing-sensitive: run it on an otherwise idle machine.
 set -euo pipefail
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
@@ -21,7 +22,7 @@ root=$(cd "$here/../.." && pwd)
 before=${BEFORE:-4aa92ef}
 work=${WORK:-/tmp/node_cpu}
 window=${WINDOW:-20}
-read -r -a sizes <<<"${SIZES:-1 8 32 64 96 128 160}"
+read -r -a sizes <<<"${SIZES:-1 8 32 64 96 128 160 192 224 256}"
 data=$root/doc/performance_data
 mkdir -p "$work" "$data"
 start=$(date +%s)
@@ -50,6 +51,8 @@ RUNS=1 WINDOW=$window OUT=$root/doc/node_cpu.csv bash "$here/run.sh" "${builds[@
   /usr/bin/python3 "$here/node_cpu.py" --label timer --window "$window" --json "$work/trigger.jsonl"
   /usr/bin/python3 "$here/node_cpu.py" --label "trigger measurement" --window "$window" \
     --launch-arg trigger:=measurement --json "$work/trigger.jsonl"
+  /usr/bin/python3 "$here/node_cpu.py" --label "roscpp relay (floor)" --floor --window "$window" \
+    --json "$work/trigger.jsonl"
   cp "$work/trigger.jsonl" "$data/node_cpu_trigger.jsonl"
   /usr/bin/python3 "$here/node_cpu.py" --report --json "$work/trigger.jsonl" \
     --csv "$root/doc/node_cpu_trigger.csv"
