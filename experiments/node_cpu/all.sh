@@ -5,6 +5,7 @@
 #   2. follower_node, plant_node and leader_node CPU per tick, before and after, at 100 Hz and
 #      1 kHz (run.sh) -> doc/node_cpu.csv, and this build's follower with ~trigger timer and
 #      measurement, and a bare roscpp relay in its place (floor.launch) -> doc/node_cpu_trigger.csv;
+#      each follower's CPU by thread (threads.py) -> doc/performance_data/node_cpu_threads.md;
 #   3. instructions per tick of each part, before and after (callgrind.sh) ->
 #      doc/performance_data/callgrind_{before,after}.txt;
 #   4. the platoon in one nodelet manager against N (platoon_cpu.py) -> doc/platoon_cpu.csv and
@@ -41,7 +42,8 @@ if [ -z "${SKIP_BEFORE:-}" ]; then
 fi
 
 step "2. CPU per tick: ${builds[*]}"
-RUNS=1 WINDOW=$window OUT=$root/doc/node_cpu.csv bash "$here/run.sh" "${builds[@]}"
+RUNS=1 WINDOW=$window OUT=$root/doc/node_cpu.csv RAW=$data/node_cpu.jsonl \
+  bash "$here/run.sh" "${builds[@]}"
 (
   set +u  # the workspace's setup scripts read unset variables
   # shellcheck disable=SC1091
@@ -56,6 +58,8 @@ RUNS=1 WINDOW=$window OUT=$root/doc/node_cpu.csv bash "$here/run.sh" "${builds[@
   cp "$work/trigger.jsonl" "$data/node_cpu_trigger.jsonl"
   /usr/bin/python3 "$here/node_cpu.py" --report --json "$work/trigger.jsonl" \
     --csv "$root/doc/node_cpu_trigger.csv"
+  /usr/bin/python3 "$here/threads.py" "$data/node_cpu.jsonl" "$data/node_cpu_trigger.jsonl" \
+    >"$data/node_cpu_threads.md"
 )
 
 step "3. instructions per part"

@@ -5,7 +5,8 @@
 # Writes doc/node_cpu.csv and prints the table.
 # Usage: experiments/node_cpu/run.sh [LABEL=BUILD_DIR ...]   (default: current=build)
 #   WINDOW (default 30 s per measurement), RUNS (default 2 rounds over the builds), OUT (default
-#   doc/node_cpu.csv). About (15 + WINDOW) s per build, rate and round: 6 min with the defaults
+#   doc/node_cpu.csv), RAW (the JSON lines of every measurement; default a temporary file).
+#   About (15 + WINDOW) s per build, rate and round: 6 min with the defaults
 #   for two builds. Timing-sensitive: run it on an otherwise idle machine.
 set -euo pipefail
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
@@ -15,7 +16,8 @@ runs=${RUNS:-2}
 out=${OUT:-$root/doc/node_cpu.csv}
 builds=("$@")
 ((${#builds[@]})) || builds=("current=$root/build")
-results=$(mktemp --suffix=.jsonl)
+results=${RAW:-$(mktemp --suffix=.jsonl)}
+rm -f "$results"
 for ((run = 1; run <= runs; run++)); do
   for spec in "${builds[@]}"; do
     label=${spec%%=*}

@@ -63,7 +63,8 @@ DEVELOPMENT_SCRIPTS = {"scripts/test.sh", "scripts/build.sh", "scripts/sanitize.
                        "experiments/fault_table/run.sh", "experiments/node_cpu/run.sh",
                        "experiments/node_cpu/node_cpu.py", "experiments/node_cpu/callgrind.sh",
                        "experiments/node_cpu/callgrind_parts.py",
-                       "experiments/node_cpu/platoon_cpu.py", "experiments/node_cpu/all.sh"}
+                       "experiments/node_cpu/platoon_cpu.py", "experiments/node_cpu/all.sh",
+                       "experiments/node_cpu/threads.py"}
 # Files under test/ that the package installs as programs: what they use is a run-time need.
 INSTALLED_PROGRAMS = {"test/reference/reference_sim.py"}
 # The experiments' shared Python helpers, imported by the experiments as local modules.
