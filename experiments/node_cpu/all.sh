@@ -4,7 +4,8 @@
 #      4aa92ef, checked out with `git worktree` into $WORK/before and built there);
 #   2. follower_node, plant_node and leader_node CPU per tick, before and after, at 100 Hz and
 #      1 kHz (run.sh) -> doc/node_cpu.csv, and this build's follower with ~trigger timer and
-#      measurement, and a bare roscpp relay in its place (floor.launch) -> doc/node_cpu_trigger.csv;
+#      measurement, with ~transport udp, and a bare roscpp relay in its place (floor.launch)
+#      -> doc/node_cpu_trigger.csv;
 #      each follower's CPU by thread (threads.py) -> doc/performance_data/node_cpu_threads.md;
 #   3. instructions per tick of each part, before and after (callgrind.sh) ->
 #      doc/performance_data/callgrind_{before,after}.txt;
@@ -53,6 +54,8 @@ RUNS=1 WINDOW=$window OUT=$root/doc/node_cpu.csv RAW=$data/node_cpu.jsonl \
   /usr/bin/python3 "$here/node_cpu.py" --label timer --window "$window" --json "$work/trigger.jsonl"
   /usr/bin/python3 "$here/node_cpu.py" --label "trigger measurement" --window "$window" \
     --launch-arg trigger:=measurement --json "$work/trigger.jsonl"
+  /usr/bin/python3 "$here/node_cpu.py" --label "transport udp" --window "$window" \
+    --launch-arg transport:=udp --json "$work/trigger.jsonl"
   /usr/bin/python3 "$here/node_cpu.py" --label "roscpp relay (floor)" --floor --window "$window" \
     --json "$work/trigger.jsonl"
   cp "$work/trigger.jsonl" "$data/node_cpu_trigger.jsonl"
