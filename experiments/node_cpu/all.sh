@@ -15,8 +15,9 @@
 # Usage: experiments/node_cpu/all.sh   (BEFORE, WORK (default /tmp/node_cpu), WINDOW (s, default
 #   20), SIZES (default "1 8 32 64 96 128 160 192 224 256"), SKIP_BEFORE=1 measures this build
 #   alone)
-# Takes about 55 min on this 2-core machine: 12 to build BEFORE (with SKIP_BEFORE=1, none),
-# 10 for step 2, 3 for step 3, 20 for step 4 (plus building this checkout if it is not built).
+# Took 18 min on this 2-core VM with BEFORE already built (building it: 2.5 min; with
+# SKIP_BEFORE=1, none): 6 for step 2, 2 for step 3, 10 for step 4 (plus building this checkout if
+# it is not built). On a slower day of the same VM its parts added up to 50 min.
 # Timing-sensitive: run it on an otherwise idle machine.
 set -euo pipefail
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
