@@ -29,7 +29,15 @@ if symbolizer=$(command -v llvm-symbolizer); then
   export ASAN_SYMBOLIZER_PATH=$symbolizer
 fi
 
-echo "== sanitizer build (ASan + UBSan, clang) in $build_dir"
+# phase NAME: "== phase NAME (at S s)", S from the first phase of this run (PCA_PHASE_EPOCH,
+# shared with scripts/test.sh).
+phase() {
+  export PCA_PHASE_EPOCH=${PCA_PHASE_EPOCH:-$(date +%s)}
+  echo "== phase $1 (at $(($(date +%s) - PCA_PHASE_EPOCH)) s)"
+}
+
+phase "sanitizers: build"
+echo "ASan + UBSan, clang, in $build_dir"
 start=$SECONDS
 cmake -S "$root/test/sanitize" -B "$build_dir" -DCMAKE_CXX_COMPILER="${CXX:-clang++}" >/dev/null
 make -C "$build_dir" -j"${JOBS:-2}" >"$build_dir/build.log" 2>&1 || {
@@ -39,7 +47,7 @@ make -C "$build_dir" -j"${JOBS:-2}" >"$build_dir/build.log" 2>&1 || {
 }
 echo "built in $((SECONDS - start)) s"
 
-echo "== core gtests under ASan + UBSan"
+phase "sanitizers: gtests"
 rm -rf "$build_dir/test_results"
 (cd "$build_dir" && ctest -j"${JOBS:-2}" --output-on-failure) || {
   echo "sanitize: core gtests failed"
@@ -54,7 +62,8 @@ if [[ $failed -ne 0 || $passed -eq 0 ]]; then
 fi
 
 if [[ $fuzz_seconds -gt 0 ]]; then
-  echo "== fuzz_follower_controller for $fuzz_seconds s"
+  phase "sanitizers: fuzzing"
+  echo "fuzz_follower_controller for $fuzz_seconds s"
   fuzz_dir=$build_dir/fuzz
   rm -rf "$fuzz_dir"
   mkdir -p "$fuzz_dir/corpus"

@@ -1,47 +1,49 @@
 #!/usr/bin/env bash
 # Sets up, builds and runs every test; exits non-zero if anything fails.
-#  1. standalone build (cmake + make), all tests (gtest + cross-check with the SciPy reference),
-#     the multi-host cases of test/multihost/run_all.sh (network namespaces, root only), all read
-#     back with catkin_test_results;
-#  2. the everyday ROS routes: the package in a fresh workspace built with catkin_make, catkin build
-#     (catkin-tools) and colcon build, each sourced and used as README says
-#     (scripts/check_workspace.sh);
+#  1. the package built in a fresh colcon workspace, as README's route does, and its tests built
+#     there too; every test registered in CMakeLists.txt (gtests, rostests, the Python checks and
+#     the cross-check with the SciPy reference) run by ctest, two at a time (those that must run
+#     alone are RUN_SERIAL); then the multi-host cases of test/multihost/run_all.sh (network
+#     namespaces, root only, two at a time); all read back with catkin_test_results;
+#  2. the other two routes, catkin_make and catkin build, each in a fresh workspace; every
+#     workspace sourced and used as README says (scripts/check_workspace.sh);
 #  3. scripts/sanitize.sh: the core gtests under ASan + UBSan (clang, standalone CMake project) and
 #     a short libFuzzer run ($SANITIZE_FUZZ_SECONDS, default 25 s).
+# Every build compiles through ccache (Debian's /usr/lib/ccache first on PATH, the cache in
+# ccache's default place or $CCACHE_DIR): the workspaces lie side by side in $TEST_BUILD_DIR
+# (default build-test/), each compiling its files from the same relative place, so that what one
+# compiled the next finds in the cache (CCACHE_BASEDIR). MAKEFLAGS=-j<cores> keeps catkin_make and
+# colcon from throttling make by the load average.
+# Each phase starts with a line "== phase NAME (at S s)", S the seconds since the first
+# (experiments/ci_time/ci_phases.py reads them).
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+package=projection_collision_avoidance
+jobs=$(nproc)
 
+# phase NAME: "== phase NAME (at S s)", S from the first phase (PCA_PHASE_EPOCH, shared with
+# scripts/sanitize.sh).
+phase() {
+  export PCA_PHASE_EPOCH=${PCA_PHASE_EPOCH:-$(date +%s)}
+  echo "== phase $1 (at $(($(date +%s) - PCA_PHASE_EPOCH)) s)"
+}
+
+phase setup
 "$root/scripts/setup.sh"
 
-echo "== standalone build and tests"
-build_dir=${BUILD_DIR:-$root/build}
-BUILD_DIR=$build_dir "$root/scripts/build.sh" tests
-rm -rf "$build_dir/test_results"
-make -C "$build_dir" run_tests >"$build_dir/run_tests.log" 2>&1 || {
-  tail -50 "$build_dir/run_tests.log"
-  echo "test: make run_tests failed (log: $build_dir/run_tests.log)"
-  exit 1
-}
-# Hosts of network namespaces (root only; reported as skipped with the reason otherwise).
-echo "== multi-host tests"
-"$root/test/multihost/run_all.sh" "$build_dir" "$build_dir/test_results/projection_collision_avoidance" || true
-results_ok=true
-catkin_test_results --verbose "$build_dir/test_results" || results_ok=false
-# Count test cases from the JUnit files: "passed failed skipped".
-read -r passed failed skipped < <(/usr/bin/python3 "$root/test/tools/count_test_results.py" "$build_dir/test_results")
-if [[ $results_ok != true || $failed -ne 0 || $passed -eq 0 ]]; then
-  echo "$passed passed, $failed failed"
-  echo "test: failing tests above"
-  exit 1
-fi
+tests_dir=${TEST_BUILD_DIR:-$root/build-test}
+rm -rf "$tests_dir"
+mkdir -p "$tests_dir"
+tests_dir=$(cd "$tests_dir" && pwd)
+export PATH=/usr/lib/ccache:$PATH CCACHE_BASEDIR=$tests_dir CCACHE_NOHASHDIR=1 MAKEFLAGS=-j$jobs
+ccache --zero-stats >/dev/null
 
-echo "== workspace builds: catkin_make, catkin build, colcon build"
-workspaces=$(mktemp -d)
-trap 'rm -rf "$workspaces"' EXIT
-for tool in catkin_make catkin_build colcon; do
-  ws=$workspaces/$tool
+# build_workspace TOOL: a fresh workspace $tests_dir/TOOL with the package in src/, built as
+# README says; prints the space to source.
+build_workspace() {
+  local tool=$1 ws=$tests_dir/$1
   mkdir -p "$ws/src"
-  ln -s "$root" "$ws/src/projection_collision_avoidance"
+  ln -s "$root" "$ws/src/$package"
   case $tool in
     catkin_make)
       (cd "$ws" && catkin_make -DPYTHON_EXECUTABLE=/usr/bin/python3 >"$ws/build.log" 2>&1) ;;
@@ -52,16 +54,65 @@ for tool in catkin_make catkin_build colcon; do
     colcon)
       (cd "$ws" && colcon build --cmake-args -DPYTHON_EXECUTABLE=/usr/bin/python3 \
         >"$ws/build.log" 2>&1) ;;
-  esac || { tail -40 "$ws/build.log"; echo "test: $tool failed"; exit 1; }
-  # README's route from there: source the workspace, then find, run and launch the package.
-  space=$ws/devel
-  [[ $tool == colcon ]] && space=$ws/install
-  "$root/scripts/check_workspace.sh" "$space" >"$ws/check.log" 2>&1 || {
-    cat "$ws/check.log"; echo "test: the $tool workspace does not run"; exit 1; }
-  echo "$tool: built; $(tail -1 "$ws/check.log")"
-done
+  esac || { tail -40 "$ws/build.log" >&2; echo "test: $tool failed" >&2; return 1; }
+}
 
-echo "== sanitizers and fuzzing"
+# check_workspace TOOL SPACE: README's route from there: source the workspace, then find, run and
+# launch the package.
+check_workspace() {
+  local tool=$1 space=$2
+  "$root/scripts/check_workspace.sh" "$space" >"$tests_dir/$tool/check.log" 2>&1 || {
+    cat "$tests_dir/$tool/check.log"; echo "test: the $tool workspace does not run"; return 1; }
+  echo "$tool: built; $(tail -1 "$tests_dir/$tool/check.log"); ccache: $(ccache_hits)"
+  ccache --zero-stats >/dev/null
+}
+
+# "H of N compilations from the cache" since the last --zero-stats.
+ccache_hits() {
+  ccache --print-stats | awk -F'\t' '
+    $1 == "direct_cache_hit" || $1 == "preprocessed_cache_hit" { hits += $2 }
+    $1 == "cache_miss" { misses += $2 }
+    END { printf "%d of %d compilations from the cache", hits, hits + misses }'
+}
+
+phase "build: colcon workspace and the tests"
+build_workspace colcon
+build=$tests_dir/colcon/build/$package
+make -C "$build" tests >"$tests_dir/colcon/tests_build.log" 2>&1 || {
+  tail -40 "$tests_dir/colcon/tests_build.log"; echo "test: building the tests failed"; exit 1; }
+# catkin caches the devel environment at configure time, keeping only directories that exist
+# then: configure once more so that it includes the generated Python messages (the Python
+# rostests import them).
+cmake "$build" >/dev/null
+check_workspace colcon "$tests_dir/colcon/install"
+
+phase "tests: gtests, rostests, Python checks (ctest -j$jobs)"
+results=$build/test_results
+rm -rf "$results"
+(cd "$build" && ctest -j"$jobs" --output-on-failure >"$build/ctest.log" 2>&1) || true
+grep -E "^ *[0-9]+/[0-9]+ Test +#" "$build/ctest.log" || true
+grep -E "tests passed|Total Test time" "$build/ctest.log" || true
+
+# Hosts of network namespaces (root only; reported as skipped with the reason otherwise).
+phase "tests: multi-host"
+MULTIHOST_JOBS=$jobs "$root/test/multihost/run_all.sh" "$build" "$results/$package" || true
+results_ok=true
+catkin_test_results --verbose "$results" || results_ok=false
+# Count test cases from the JUnit files: "passed failed skipped".
+read -r passed failed skipped < <(/usr/bin/python3 "$root/test/tools/count_test_results.py" "$results")
+if [[ $results_ok != true || $failed -ne 0 || $passed -eq 0 ]]; then
+  echo "$passed passed, $failed failed"
+  echo "test: failing tests above (ctest's log: $build/ctest.log)"
+  exit 1
+fi
+
+phase "build: catkin_make workspace"
+build_workspace catkin_make
+check_workspace catkin_make "$tests_dir/catkin_make/devel"
+phase "build: catkin build workspace"
+build_workspace catkin_build
+check_workspace catkin_build "$tests_dir/catkin_build/devel"
+
 sanitize_dir=${SANITIZE_BUILD_DIR:-$root/build-sanitize}
 fuzz_seconds=${SANITIZE_FUZZ_SECONDS:-25}
 SANITIZE_BUILD_DIR=$sanitize_dir "$root/scripts/sanitize.sh" --fuzz-seconds "$fuzz_seconds" || {
@@ -71,5 +122,6 @@ SANITIZE_BUILD_DIR=$sanitize_dir "$root/scripts/sanitize.sh" --fuzz-seconds "$fu
 }
 # The same count over the sanitizer build's gtest XML.
 read -r san_passed san_failed san_skipped < <(/usr/bin/python3 "$root/test/tools/count_test_results.py" "$sanitize_dir/test_results")
+phase end
 echo "$passed passed, $failed failed, $skipped skipped" \
   "(and under ASan + UBSan: $san_passed passed, $san_failed failed; fuzzed $fuzz_seconds s)"

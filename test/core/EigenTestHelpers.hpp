@@ -1,14 +1,14 @@
 #pragma once
 
 /// @file
-/// Eigen-aware gtest assertions that print both operands on failure, and random generators.
+/// Eigen-aware gtest assertions that print both operands on failure, and random generators
+/// (defined in EigenTestHelpers.cpp).
 
 #include <random>
 #include <sstream>
 
 #include <Eigen/Core>
 #include <Eigen/LU>
-#include <Eigen/QR>
 #include <gtest/gtest.h>
 
 namespace projection_collision_avoidance {
@@ -31,38 +31,15 @@ template <typename A, typename B>
   return ::testing::AssertionFailure() << message.str();
 }
 
-/// Random symmetric positive definite n x n matrix with eigenvalues in [low, high].
-inline Eigen::MatrixXd randomSpd(std::mt19937& rng, int n, double low, double high) {
-  std::normal_distribution<double> normal;
-  std::uniform_real_distribution<double> uniform(low, high);
-  Eigen::MatrixXd M(n, n);
-  for (int i = 0; i < n; ++i) {
-    for (int j = 0; j < n; ++j) {
-      M(i, j) = normal(rng);
-    }
-  }
-  const Eigen::MatrixXd Q = Eigen::HouseholderQR<Eigen::MatrixXd>(M).householderQ();
-  Eigen::VectorXd values(n);
-  for (int i = 0; i < n; ++i) {
-    values(i) = uniform(rng);
-  }
-  return Q * values.asDiagonal() * Q.transpose();
-}
+/// Random symmetric positive definite n x n matrix with eigenvalues in [low, high]
+/// (EigenTestHelpers.cpp: its QR decomposition is compiled once, not in every test).
+Eigen::MatrixXd randomSpd(std::mt19937& rng, int n, double low, double high);
 
-inline Eigen::VectorXd randomVector(std::mt19937& rng, int n, double scale = 1.0) {
-  std::normal_distribution<double> normal(0.0, scale);
-  Eigen::VectorXd v(n);
-  for (int i = 0; i < n; ++i) {
-    v(i) = normal(rng);
-  }
-  return v;
-}
+/// A vector of n independent normal entries of standard deviation @p scale.
+Eigen::VectorXd randomVector(std::mt19937& rng, int n, double scale = 1.0);
 
 /// A random direction scaled to @p radius.
-inline Eigen::VectorXd randomOnSphere(std::mt19937& rng, int n, double radius) {
-  Eigen::VectorXd v = randomVector(rng, n);
-  return radius * v / v.norm();
-}
+Eigen::VectorXd randomOnSphere(std::mt19937& rng, int n, double radius);
 
 }  // namespace testing
 }  // namespace projection_collision_avoidance

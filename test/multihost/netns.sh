@@ -19,7 +19,16 @@ netns_cleanup() {
   for ns in "${netns_hosts[@]}"; do
     ip netns pids "$ns" 2>/dev/null | xargs -r kill -INT 2>/dev/null || true
   done
-  sleep 2
+  # Up to 5 s for them to end on SIGINT, then SIGKILL.
+  local _ ns_pids
+  for _ in $(seq 50); do
+    ns_pids=""
+    for ns in "${netns_hosts[@]}"; do
+      ns_pids+=$(ip netns pids "$ns" 2>/dev/null || true)
+    done
+    [[ -z $ns_pids ]] && break
+    sleep 0.1
+  done
   for ns in "${netns_hosts[@]}"; do
     ip netns pids "$ns" 2>/dev/null | xargs -r kill -KILL 2>/dev/null || true
     ip netns del "$ns" 2>/dev/null || true

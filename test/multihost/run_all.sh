@@ -5,6 +5,7 @@
 # passed. The "refused" case expects the run to fail: a follower host 2 s ahead judged on its
 # stamps has its measurements refused as stale (and its commands would be refused by the plant).
 # Usage: test/multihost/run_all.sh BUILD_DIR RESULTS_DIR [CASE...]   (default: every case)
+# Environment: MULTIHOST_JOBS, how many cases run at once (default 1).
 set -uo pipefail
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 build=${1:?build dir}
@@ -32,41 +33,61 @@ order+=(pair_ahead_2s_stamps_refused formation_sim_time formation_skewed_estimat
 
 mkdir -p "$results"
 xml=$results/multihost.xml
+for name in "${order[@]}"; do
+  [[ -n ${cases[$name]:-} ]] || { echo "unknown case $name" >&2; exit 2; }
+done
+# Every case has hosts of its own (namespaces named by its process id, a master in each): up to
+# $MULTIHOST_JOBS of them run at once.
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+run_case() {
+  local name=$1 logdir=$work/$1 start=$SECONDS kind rest
+  mkdir -p "$logdir"
+  read -r kind rest <<<"${cases[$name]}"
+  # shellcheck disable=SC2086
+  bash "$here/hosts.sh" "$build" "$kind" --log "$logdir" $rest >"$logdir/run.log" 2>&1
+  echo "$? $((SECONDS - start))" >"$logdir/result"
+}
+running=0
+for name in "${order[@]}"; do
+  if [[ $running -ge ${MULTIHOST_JOBS:-1} ]]; then
+    wait -n
+    running=$((running - 1))
+  fi
+  run_case "$name" &
+  running=$((running + 1))
+done
+wait
+
 body=""
 failures=0
 skipped=0
 for name in "${order[@]}"; do
-  [[ -n ${cases[$name]:-} ]] || { echo "unknown case $name" >&2; exit 2; }
-  logdir=$(mktemp -d)
-  start=$SECONDS
-  read -r kind rest <<<"${cases[$name]}"
-  # shellcheck disable=SC2086
-  bash "$here/hosts.sh" "$build" "$kind" --log "$logdir" $rest >"$logdir/run.log" 2>&1
-  rc=$?
+  logdir=$work/$name
+  read -r rc seconds <"$logdir/result"
   outcome=passed
   if [[ $rc == 77 ]]; then
     outcome="skipped: $(grep -m1 '^skipped:' "$logdir/run.log" | cut -c10-)"
-    body+="  <testcase classname=\"multihost\" name=\"$name\"><skipped message=\"${outcome#skipped: }\"/></testcase>"$'\n'
+    body+="  <testcase classname=\"multihost\" name=\"$name\" time=\"$seconds\"><skipped message=\"${outcome#skipped: }\"/></testcase>"$'\n'
     skipped=$((skipped + 1))
   elif [[ $name == *_refused ]]; then
     if [[ $rc == 1 ]] && grep -q "relative_measurement rejected: stale" "$logdir"/follower_*.log; then
-      body+="  <testcase classname=\"multihost\" name=\"$name\"/>"$'\n'
+      body+="  <testcase classname=\"multihost\" name=\"$name\" time=\"$seconds\"/>"$'\n'
     else
       outcome="FAILED: expected the run to fail with the measurements refused as stale (exit $rc)"
-      body+="  <testcase classname=\"multihost\" name=\"$name\"><failure message=\"$outcome\"/></testcase>"$'\n'
+      body+="  <testcase classname=\"multihost\" name=\"$name\" time=\"$seconds\"><failure message=\"$outcome\"/></testcase>"$'\n'
       failures=$((failures + 1))
     fi
   elif [[ $rc == 0 ]]; then
-    body+="  <testcase classname=\"multihost\" name=\"$name\"/>"$'\n'
+    body+="  <testcase classname=\"multihost\" name=\"$name\" time=\"$seconds\"/>"$'\n'
   else
     outcome="FAILED (exit $rc)"
     tail -40 "$logdir/run.log"
-    body+="  <testcase classname=\"multihost\" name=\"$name\"><failure message=\"exit $rc\"/></testcase>"$'\n'
+    body+="  <testcase classname=\"multihost\" name=\"$name\" time=\"$seconds\"><failure message=\"exit $rc\"/></testcase>"$'\n'
     failures=$((failures + 1))
   fi
-  echo "multihost $name: $outcome ($((SECONDS - start)) s) [${cases[$name]}]"
+  echo "multihost $name: $outcome ($seconds s) [${cases[$name]}]"
   grep -rh "ROS run:\|ROS max" "$logdir/ros" 2>/dev/null | sed 's/.*\(ROS run:\|follower_[0-9]* ->\)/    \1/' | sed 's/\x1b\[[0-9;]*m//g' | sort -u || true
-  rm -rf "$logdir"
 done
 {
   echo '<?xml version="1.0" encoding="UTF-8"?>'

@@ -1,0 +1,185 @@
+#!/usr/bin/python3
+"""Where the time of one `scripts/test.sh` run goes, read from its log.
+
+Two kinds of log are read:
+  - scripts/test.sh's own output (as `.ci/run` prints it): every phase starts with a line
+    `== phase NAME (at S s)`, S the seconds since test.sh started; the run ends with
+    `== phase end (at S s)`.
+  - a log whose every line starts with the Unix time it was printed (experiments/ci_time/run.sh
+    writes one, for a build whose test.sh printed no times): a phase starts at each line that
+    matches one of LEGACY_MARKERS.
+The tests' own times come from ctest's lines (`N/M Test #K: NAME ... Passed 12.34 sec`) when the
+log has them, or from the JUnit XML files of a results directory (--results), grouped by kind.
+
+Usage:
+  ci_phases.py phases LOG                     a table of the phases
+  ci_phases.py tests (--log LOG | --results DIR)   the tests' times by group
+  ci_phases.py report --before LOG [--before-results DIR] --after LOG [--after-results DIR]
+                      [--update FILE]         the markdown of doc/testing.md's section; with
+                                              --update, written between its markers
+"""
+
+import argparse
+import pathlib
+import re
+import sys
+import xml.etree.ElementTree as ET
+
+PHASE = re.compile(r"^== phase (?P<name>.+) \(at (?P<at>\d+) s\)\s*$")
+STAMPED = re.compile(r"^(?P<epoch>\d{10}) (?P<text>.*)$")
+# Phase starts in the output of scripts/test.sh before it printed its own times.
+LEGACY_MARKERS = [
+    (re.compile(r"^fresh-debian-run: clean clone"), "setup"),
+    (re.compile(r"^== standalone build and tests"), "build + tests: standalone, make run_tests"),
+    (re.compile(r"^== multi-host tests"), "tests: multi-host"),
+    (re.compile(r"^== workspace builds"), "build: catkin_make workspace"),
+    (re.compile(r"^catkin_make: built"), "build: catkin build workspace"),
+    (re.compile(r"^catkin_build: built"), "build: colcon workspace"),
+    (re.compile(r"^== sanitizer build"), "sanitizers: build"),
+    (re.compile(r"^== core gtests under ASan"), "sanitizers: gtests"),
+    (re.compile(r"^== fuzz_follower_controller"), "sanitizers: fuzzing"),
+    (re.compile(r"^fresh-debian-run: exit"), "end"),
+]
+CTEST = re.compile(r"^\s*\d+/\d+ Test +#\d+: (?P<name>\S+) .*?(?P<sec>\d+\.\d+) sec\s*$")
+BEGIN = "<!-- ci-phases: begin (experiments/ci_time/ci_phases.py report) -->"
+END = "<!-- ci-phases: end -->"
+
+
+def read_phases(path):
+    """[(name, seconds)] in order, from either kind of log."""
+    starts = []
+    for line in pathlib.Path(path).read_text(errors="replace").splitlines():
+        m = PHASE.match(line)
+        if m:
+            starts.append((m["name"], float(m["at"])))
+            continue
+        m = STAMPED.match(line)
+        if m:
+            for marker, name in LEGACY_MARKERS:
+                if marker.match(m["text"]):
+                    starts.append((name, float(m["epoch"])))
+    if not starts or starts[-1][0] != "end":
+        sys.exit(f"{path}: no end of the run found (an unfinished run?)")
+    return [(name, nxt - at) for (name, at), (_, nxt) in zip(starts, starts[1:])]
+
+
+def group_of(name):
+    """The kind of a test from its ctest or file name."""
+    for kind in ("gtest", "rostest", "rosunit", "python", "multihost"):
+        if re.search(rf"(^|_){kind}[-_]", name + "_"):
+            return "rostest" if kind == "rosunit" else kind
+    return "other"
+
+
+def tests_from_log(path):
+    times = {}
+    for line in pathlib.Path(path).read_text(errors="replace").splitlines():
+        m = CTEST.match(STAMPED.sub(r"\g<text>", line))
+        if m:
+            group = group_of(m["name"])
+            count, total = times.get(group, (0, 0.0))
+            times[group] = (count + 1, total + float(m["sec"]))
+    return times
+
+
+def tests_from_results(directory):
+    """Per group (tests, s) from the suites' time attributes (rosunit-* files repeat a rostest's
+    inner suite and are skipped)."""
+    times = {}
+    for path in sorted(pathlib.Path(directory).rglob("*.xml")):
+        if path.name.startswith("rosunit-"):
+            continue
+        root = ET.parse(path).getroot()
+        suite = root if root.tag == "testsuite" else root.find("testsuite")
+        seconds = float(suite.get("time", 0.0)) if suite is not None else 0.0
+        group = group_of(path.name)
+        count, total = times.get(group, (0, 0.0))
+        times[group] = (count + 1, total + seconds)
+    return times
+
+
+def minutes(seconds):
+    return f"{seconds / 60:.1f}"
+
+
+def phases_table(before, after):
+    names = []
+    for name, _ in before + after:
+        if name not in names:
+            names.append(name)
+    b, a = dict(before), dict(after)
+    rows = ["| phase | before (min) | after (min) |", "|---|---|---|"]
+    for name in names:
+        rows.append(f"| {name} | {minutes(b[name]) if name in b else '—'} | "
+                    f"{minutes(a[name]) if name in a else '—'} |")
+    rows.append(f"| **total** | **{minutes(sum(b.values()))}** | **{minutes(sum(a.values()))}** |")
+    return "\n".join(rows)
+
+
+def tests_table(before, after):
+    rows = ["| tests | before: files or tests, summed min | after: files or tests, summed min |",
+            "|---|---|---|"]
+    for group in ("gtest", "python", "rostest", "multihost", "other"):
+        if group in before or group in after:
+            cells = []
+            for times in (before, after):
+                count, total = times.get(group, (0, 0.0))
+                cells.append(f"{count}, {minutes(total)}" if count else "—")
+            rows.append(f"| {group} | {cells[0]} | {cells[1]} |")
+    return "\n".join(rows)
+
+
+def test_times(log, results):
+    times = tests_from_results(results) if results else {}
+    if not times:
+        times = tests_from_log(log)
+    return times
+
+
+def report(args):
+    before, after = read_phases(args.before), read_phases(args.after)
+    text = "\n\n".join([
+        phases_table(before, after),
+        "Each group's tests, their own times summed (tests that run two at a time overlap, so a "
+        "sum can exceed its phase):",
+        tests_table(test_times(args.before, args.before_results),
+                    test_times(args.after, args.after_results)),
+    ])
+    if not args.update:
+        print(text)
+        return
+    doc = pathlib.Path(args.update)
+    content = doc.read_text()
+    if BEGIN not in content or END not in content:
+        sys.exit(f"{doc}: no markers {BEGIN} ... {END}")
+    head, rest = content.split(BEGIN, 1)
+    _, tail = rest.split(END, 1)
+    doc.write_text(f"{head}{BEGIN}\n{text}\n{END}{tail}")
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    sub = parser.add_subparsers(dest="command", required=True)
+    p = sub.add_parser("phases")
+    p.add_argument("log")
+    t = sub.add_parser("tests")
+    t.add_argument("--log")
+    t.add_argument("--results")
+    r = sub.add_parser("report")
+    for which in ("before", "after"):
+        r.add_argument(f"--{which}", required=True)
+        r.add_argument(f"--{which}-results")
+    r.add_argument("--update")
+    args = parser.parse_args()
+    if args.command == "phases":
+        for name, seconds in read_phases(args.log):
+            print(f"{seconds:8.0f} s  {name}")
+    elif args.command == "tests":
+        for group, (count, total) in test_times(args.log, args.results).items():
+            print(f"{group:10s} {count:4d} {total:8.0f} s")
+    else:
+        report(args)
+
+
+if __name__ == "__main__":
+    main()
