@@ -72,7 +72,7 @@ EXPERIMENT_HELPERS = Path("experiments") / "common"
 # Debian packages used by the scripts but not dependencies of the package: catkin's own
 # toolchain, and the workspace tools a user picks. They are in scripts/debian-packages.txt.
 TOOLCHAIN = {"make", "cmake", "catkin", "catkin-tools", "colcon", "python3-colcon-ros",
-             "python3-colcon-bash", "git"}
+             "python3-colcon-bash", "git", "ccache"}
 COMMAND_WORD = re.compile(r"^[A-Za-z][A-Za-z0-9_.+-]*$")
 
 
