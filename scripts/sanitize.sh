@@ -39,7 +39,11 @@ phase() {
 phase "sanitizers: build"
 echo "ASan + UBSan, clang, in $build_dir"
 start=$SECONDS
-cmake -S "$root/test/sanitize" -B "$build_dir" -DCMAKE_CXX_COMPILER="${CXX:-clang++}" >/dev/null
+# Through ccache when there is one (a rebuild of the same sources comes out of the cache).
+launcher=()
+command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+cmake -S "$root/test/sanitize" -B "$build_dir" -DCMAKE_CXX_COMPILER="${CXX:-clang++}" \
+  "${launcher[@]}" >/dev/null
 make -C "$build_dir" -j"${JOBS:-2}" >"$build_dir/build.log" 2>&1 || {
   tail -40 "$build_dir/build.log"
   echo "sanitize: build failed (log: $build_dir/build.log)"

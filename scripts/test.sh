@@ -9,11 +9,8 @@
 #     workspace sourced and used as README says (scripts/check_workspace.sh);
 #  3. scripts/sanitize.sh: the core gtests under ASan + UBSan (clang, standalone CMake project) and
 #     a short libFuzzer run ($SANITIZE_FUZZ_SECONDS, default 25 s).
-# Every build compiles through ccache (Debian's /usr/lib/ccache first on PATH, the cache in
-# ccache's default place or $CCACHE_DIR): the workspaces lie side by side in $TEST_BUILD_DIR
-# (default build-test/), each compiling its files from the same relative place, so that what one
-# compiled the next finds in the cache (CCACHE_BASEDIR). MAKEFLAGS=-j<cores> keeps catkin_make and
-# colcon from throttling make by the load average.
+# The workspaces lie side by side in $TEST_BUILD_DIR (default: a new folder in $TMPDIR or /tmp),
+# each built by scripts/workspace.sh through one ccache: what the first compiled, the others find.
 # Each phase starts with a line "== phase NAME (at S s)", S the seconds since the first
 # (experiments/ci_time/ci_phases.py reads them).
 set -euo pipefail
@@ -31,31 +28,20 @@ phase() {
 phase setup
 "$root/scripts/setup.sh"
 
-tests_dir=${TEST_BUILD_DIR:-$root/build-test}
-rm -rf "$tests_dir"
-mkdir -p "$tests_dir"
-tests_dir=$(cd "$tests_dir" && pwd)
-export PATH=/usr/lib/ccache:$PATH CCACHE_BASEDIR=$tests_dir CCACHE_NOHASHDIR=1 MAKEFLAGS=-j$jobs
+# The workspaces, outside the package (a workspace inside it, linked back to it from its src/,
+# would let roslaunch and rospack find the package again at every level). Removed when every
+# test passed, kept for a look otherwise.
+if [[ -n ${TEST_BUILD_DIR:-} ]]; then
+  tests_dir=$TEST_BUILD_DIR
+  rm -rf "$tests_dir"
+  mkdir -p "$tests_dir"
+else
+  tests_dir=$(mktemp -d "${TMPDIR:-/tmp}/$package-test.XXXXXX")
+fi
+echo "test: workspaces in $tests_dir"
+passed_all=false
+trap '[[ $passed_all == true ]] && rm -rf "$tests_dir" || echo "test: workspaces kept in $tests_dir"' EXIT
 ccache --zero-stats >/dev/null
-
-# build_workspace TOOL: a fresh workspace $tests_dir/TOOL with the package in src/, built as
-# README says; prints the space to source.
-build_workspace() {
-  local tool=$1 ws=$tests_dir/$1
-  mkdir -p "$ws/src"
-  ln -s "$root" "$ws/src/$package"
-  case $tool in
-    catkin_make)
-      (cd "$ws" && catkin_make -DPYTHON_EXECUTABLE=/usr/bin/python3 >"$ws/build.log" 2>&1) ;;
-    catkin_build)
-      (cd "$ws" && catkin init >/dev/null &&
-        catkin config --cmake-args -DPYTHON_EXECUTABLE=/usr/bin/python3 >/dev/null &&
-        catkin build --no-status >"$ws/build.log" 2>&1) ;;
-    colcon)
-      (cd "$ws" && colcon build --cmake-args -DPYTHON_EXECUTABLE=/usr/bin/python3 \
-        >"$ws/build.log" 2>&1) ;;
-  esac || { tail -40 "$ws/build.log" >&2; echo "test: $tool failed" >&2; return 1; }
-}
 
 # check_workspace TOOL SPACE: README's route from there: source the workspace, then find, run and
 # launch the package.
@@ -76,14 +62,7 @@ ccache_hits() {
 }
 
 phase "build: colcon workspace and the tests"
-build_workspace colcon
-build=$tests_dir/colcon/build/$package
-make -C "$build" tests >"$tests_dir/colcon/tests_build.log" 2>&1 || {
-  tail -40 "$tests_dir/colcon/tests_build.log"; echo "test: building the tests failed"; exit 1; }
-# catkin caches the devel environment at configure time, keeping only directories that exist
-# then: configure once more so that it includes the generated Python messages (the Python
-# rostests import them).
-cmake "$build" >/dev/null
+build=$("$root/scripts/workspace.sh" colcon "$tests_dir" --tests)
 check_workspace colcon "$tests_dir/colcon/install"
 
 phase "tests: gtests, rostests, Python checks (ctest -j$jobs)"
@@ -107,10 +86,10 @@ if [[ $results_ok != true || $failed -ne 0 || $passed -eq 0 ]]; then
 fi
 
 phase "build: catkin_make workspace"
-build_workspace catkin_make
+"$root/scripts/workspace.sh" catkin_make "$tests_dir" >/dev/null
 check_workspace catkin_make "$tests_dir/catkin_make/devel"
 phase "build: catkin build workspace"
-build_workspace catkin_build
+"$root/scripts/workspace.sh" catkin_build "$tests_dir" >/dev/null
 check_workspace catkin_build "$tests_dir/catkin_build/devel"
 
 sanitize_dir=${SANITIZE_BUILD_DIR:-$root/build-sanitize}
@@ -123,5 +102,6 @@ SANITIZE_BUILD_DIR=$sanitize_dir "$root/scripts/sanitize.sh" --fuzz-seconds "$fu
 # The same count over the sanitizer build's gtest XML.
 read -r san_passed san_failed san_skipped < <(/usr/bin/python3 "$root/test/tools/count_test_results.py" "$sanitize_dir/test_results")
 phase end
+passed_all=true
 echo "$passed passed, $failed failed, $skipped skipped" \
   "(and under ASan + UBSan: $san_passed passed, $san_failed failed; fuzzed $fuzz_seconds s)"

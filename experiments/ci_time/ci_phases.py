@@ -5,21 +5,25 @@ Two kinds of log are read:
   - scripts/test.sh's own output (as `.ci/run` prints it): every phase starts with a line
     `== phase NAME (at S s)`, S the seconds since test.sh started; the run ends with
     `== phase end (at S s)`.
-  - a log whose every line starts with the Unix time it was printed (experiments/ci_time/run.sh
-    writes one, for a build whose test.sh printed no times): a phase starts at each line that
+  - for a test.sh that printed no phase lines, a log whose every line starts with the Unix time it
+    was printed (experiments/ci_time/run.sh writes one): a phase starts at each line that
     matches one of LEGACY_MARKERS.
+A log may be gzipped (.gz).
 The tests' own times come from ctest's lines (`N/M Test #K: NAME ... Passed 12.34 sec`) when the
 log has them, or from the JUnit XML files of a results directory (--results), grouped by kind.
 
 Usage:
   ci_phases.py phases LOG                     a table of the phases
-  ci_phases.py tests (--log LOG | --results DIR)   the tests' times by group
-  ci_phases.py report --before LOG [--before-results DIR] --after LOG [--after-results DIR]
+  ci_phases.py tests (--log LOG | --results DIR) [--csv CSV]   the tests' times by group
+  ci_phases.py report --before LOG [--before-results DIR|CSV] --after LOG
+                      [--after-results DIR|CSV]
                       [--update FILE]         the markdown of doc/testing.md's section; with
                                               --update, written between its markers
 """
 
 import argparse
+import csv
+import gzip
 import pathlib
 import re
 import sys
@@ -45,19 +49,28 @@ BEGIN = "<!-- ci-phases: begin (experiments/ci_time/ci_phases.py report) -->"
 END = "<!-- ci-phases: end -->"
 
 
+def read_lines(path):
+    """The log's lines (a .gz file is read uncompressed)."""
+    path = pathlib.Path(path)
+    data = gzip.decompress(path.read_bytes()) if path.suffix == ".gz" else path.read_bytes()
+    return data.decode(errors="replace").splitlines()
+
+
 def read_phases(path):
-    """[(name, seconds)] in order, from either kind of log."""
-    starts = []
-    for line in pathlib.Path(path).read_text(errors="replace").splitlines():
-        m = PHASE.match(line)
+    """[(name, seconds)] in order: from test.sh's own phase lines where there are any, else from
+    the Unix times of a stamped log's LEGACY_MARKERS."""
+    phases, legacy = [], []
+    for line in read_lines(path):
+        stamped = STAMPED.match(line)
+        text = stamped["text"] if stamped else line
+        m = PHASE.match(text)
         if m:
-            starts.append((m["name"], float(m["at"])))
-            continue
-        m = STAMPED.match(line)
-        if m:
+            phases.append((m["name"], float(m["at"])))
+        elif stamped:
             for marker, name in LEGACY_MARKERS:
-                if marker.match(m["text"]):
-                    starts.append((name, float(m["epoch"])))
+                if marker.match(text):
+                    legacy.append((name, float(stamped["epoch"])))
+    starts = phases or legacy
     if not starts or starts[-1][0] != "end":
         sys.exit(f"{path}: no end of the run found (an unfinished run?)")
     return [(name, nxt - at) for (name, at), (_, nxt) in zip(starts, starts[1:])]
@@ -66,14 +79,14 @@ def read_phases(path):
 def group_of(name):
     """The kind of a test from its ctest or file name."""
     for kind in ("gtest", "rostest", "rosunit", "python", "multihost"):
-        if re.search(rf"(^|_){kind}[-_]", name + "_"):
+        if re.search(rf"(^|_){kind}[-_.]", name + "_"):
             return "rostest" if kind == "rosunit" else kind
     return "other"
 
 
 def tests_from_log(path):
     times = {}
-    for line in pathlib.Path(path).read_text(errors="replace").splitlines():
+    for line in read_lines(path):
         m = CTEST.match(STAMPED.sub(r"\g<text>", line))
         if m:
             group = group_of(m["name"])
@@ -124,16 +137,22 @@ def tests_table(before, after):
             cells = []
             for times in (before, after):
                 count, total = times.get(group, (0, 0.0))
-                cells.append(f"{count}, {minutes(total)}" if count else "—")
+                cells.append("—" if not count else
+                             f"{count}, {minutes(total)}" if total > 0 else f"{count}, not timed")
             rows.append(f"| {group} | {cells[0]} | {cells[1]} |")
     return "\n".join(rows)
 
 
 def test_times(log, results):
-    times = tests_from_results(results) if results else {}
-    if not times:
-        times = tests_from_log(log)
-    return times
+    """The tests' times of a run: from RESULTS (a folder of JUnit files, or a CSV of `tests
+    --csv`) when given, else from ctest's lines in its log."""
+    if not results:
+        return tests_from_log(log)
+    if results.endswith(".csv"):
+        with open(results) as f:
+            return {row["group"]: (int(row["tests"]), float(row["seconds"]))
+                    for row in csv.DictReader(f)}
+    return tests_from_results(results)
 
 
 def report(args):
@@ -165,6 +184,7 @@ def main():
     t = sub.add_parser("tests")
     t.add_argument("--log")
     t.add_argument("--results")
+    t.add_argument("--csv", help="write the groups' times there")
     r = sub.add_parser("report")
     for which in ("before", "after"):
         r.add_argument(f"--{which}", required=True)
@@ -175,7 +195,14 @@ def main():
         for name, seconds in read_phases(args.log):
             print(f"{seconds:8.0f} s  {name}")
     elif args.command == "tests":
-        for group, (count, total) in test_times(args.log, args.results).items():
+        times = test_times(args.log, args.results)
+        if args.csv:
+            with open(args.csv, "w", newline="") as f:
+                writer = csv.writer(f)
+                writer.writerow(["group", "tests", "seconds"])
+                for group, (count, total) in sorted(times.items()):
+                    writer.writerow([group, count, f"{total:.1f}"])
+        for group, (count, total) in sorted(times.items()):
             print(f"{group:10s} {count:4d} {total:8.0f} s")
     else:
         report(args)

@@ -81,6 +81,13 @@ class PlantVehicle {
   }
   /// The body frame's yaw in the world (rad).
   double yaw() const;
+  /// Lockstep: whether the vehicle answered the sample stamped @p sample: a command received at
+  /// plant time @p sample or later, no command yet, or nobody publishing cmd_vel or
+  /// cmd_vel_stamped.
+  bool answered(const ros::Time& sample) const {
+    return !have_command_ || received_ >= sample ||
+           (twist_subscriber_.getNumPublishers() == 0 && stamped_subscriber_.getNumPublishers() == 0);
+  }
 
  private:
   /// The command of a Twist's content; false, with the reason, when it is refused.

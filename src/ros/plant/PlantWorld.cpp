@@ -282,9 +282,17 @@ void PlantWorld::advanceAll(long k) {
 }
 
 bool PlantWorld::commandsAnswer(long k) const {
-  const std::int64_t due = nanosecondsOf(clock_->stampOf(k));
-  const auto answered = [due](const Agent& agent) {
-    return agent.vehicle || !agent.command_guard.haveAccepted() || agent.command_stamp >= due;
+  const ros::Time due_time = clock_->stampOf(k);
+  const std::int64_t due = nanosecondsOf(due_time);
+  // Waited for: an agent that has commanded and still has a sender (one that was stopped, or
+  // whose node ended, holds nobody up); it answers with a command stamped at t_k or later (a
+  // vehicle's Twist carries no stamp: one received after sample k went out).
+  const auto answered = [due, &due_time](const Agent& agent) {
+    if (agent.vehicle) {
+      return agent.vehicle->answered(due_time);
+    }
+    return !agent.command_guard.haveAccepted() || agent.command_subscriber.getNumPublishers() == 0 ||
+           agent.command_stamp >= due;
   };
   return answered(leader_) &&
          std::all_of(followers_.begin(), followers_.end(),

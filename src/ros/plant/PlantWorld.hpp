@@ -52,7 +52,8 @@ namespace projection_collision_avoidance {
 /// takes Twists on `<agent>/cmd_vel` (and TwistStamped on `<agent>/cmd_vel_stamped`), publishes
 /// its odometry and tf with its heading and twist in its body frame, and its applied command as
 /// a TwistStamped; its measurements are those of its odometry's origin, as for a double
-/// integrator; the leader's u_d does not act on it, and lockstep does not wait for it.
+/// integrator; the leader's u_d does not act on it. Lockstep waits for a vehicle's Twist
+/// received after sample k went out.
 ///
 /// Time: PlantClock. With publish_clock the plant owns simulated time (stamps t_k from 0), ticking
 /// on a wall timer at rate * real_time_factor (catching up ticks that a late callback missed).
@@ -116,7 +117,8 @@ class PlantWorld {
   void advanceAgent(Agent* agent, double t, const ros::Time& stamp);
   /// Integrates every agent over [t_k, t_k+1] with its command held; the leader under u_d.
   void advanceAll(long k);
-  /// Lockstep: whether every agent that has commanded has a command stamped at or after t_k.
+  /// Lockstep: whether every agent that has commanded and still has a sender answered sample k:
+  /// a command stamped at or after t_k (a vehicle: a Twist received after sample k went out).
   bool commandsAnswer(long k) const;
   void publishMarkers(const ros::Time& stamp);
   /// The agent a follower is measured against.
