@@ -45,8 +45,8 @@ CommandAdapter::CommandAdapter(ros::NodeHandle nh, ros::NodeHandle private_nh)
       watchdog_(options_->command_timeout),
       command_guard_("command", {"", 0.1, options_->command_timeout}),
       odometry_guard_("odom", {"", 0.1, 0.0}),
-      base_frame_(options_->base_frame),
       world_frame_(options_->world_frame),
+      base_frame_(options_->base_frame),
       acceleration_(Eigen::VectorXd::Zero(options_->converter.axes)) {
   if (options_->accel_enu) {
     accel_publisher_ = nh.advertise<geometry_msgs::Vector3Stamped>("setpoint_accel", 10);

@@ -248,6 +248,35 @@ std::string NodeOptionReader::text(const std::string& key, const std::string& fa
   return result;
 }
 
+std::vector<std::string> NodeOptionReader::textList(const std::string& key,
+                                                    std::size_t max_entries) {
+  XmlRpc::XmlRpcValue value;
+  std::vector<std::string> result;
+  const bool present = lookup(key, &value);
+  if (present) {
+    if (value.getType() != XmlRpc::XmlRpcValue::TypeArray) {
+      throw ParameterError("~" + key, "must be a list of strings, got " + typeName(value));
+    }
+    if (static_cast<std::size_t>(value.size()) > max_entries) {
+      throw ParameterError("~" + key, "must have at most " + std::to_string(max_entries) +
+                                          " entries, got " + std::to_string(value.size()));
+    }
+    for (int i = 0; i < value.size(); ++i) {
+      if (value[i].getType() != XmlRpc::XmlRpcValue::TypeString) {
+        throw ParameterError("~" + key + "[" + std::to_string(i) + "]",
+                             "must be a string, got " + typeName(value[i]));
+      }
+      result.push_back(static_cast<std::string>(value[i]));
+    }
+  }
+  std::string echoed = "[";
+  for (const std::string& entry : result) {
+    echoed += (echoed.size() > 1 ? ", '" : "'") + entry + "'";
+  }
+  remember(key, echoed + "]", !present);
+  return result;
+}
+
 std::vector<std::string> NodeOptionReader::mapKeys(const std::string& key) {
   XmlRpc::XmlRpcValue value;
   std::vector<std::string> keys;

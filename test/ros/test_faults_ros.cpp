@@ -104,12 +104,15 @@ class FaultTest : public testing::FollowerTest {
   void onLeaderOdom(const nav_msgs::Odometry::ConstPtr& msg) {
     const std::lock_guard<std::mutex> lock(mutex_);
     leader_ = *msg;
+    have_leader_ = true;
   }
 
   void onFollowerOdom(const nav_msgs::Odometry::ConstPtr& msg) {
     const std::lock_guard<std::mutex> lock(mutex_);
-    if (leader_.header.stamp != msg->header.stamp) {
-      return;  // pair the two agents' samples of the same tick only
+    if (!have_leader_ || leader_.header.stamp != msg->header.stamp) {
+      // Pair the two agents' samples of the same tick only (the first tick's, stamped 0, can
+      // come before any leader sample: never pair it with the empty message).
+      return;
     }
     Eigen::VectorXd leader;
     Eigen::VectorXd follower;
@@ -141,6 +144,7 @@ class FaultTest : public testing::FollowerTest {
   }
 
   nav_msgs::Odometry leader_;
+  bool have_leader_ = false;  ///< leader_ holds a received sample
   Eigen::VectorXd last_applied_;
   bool have_applied_ = false;
   ros::Subscriber leader_subscriber_;

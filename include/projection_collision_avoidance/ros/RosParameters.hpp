@@ -64,6 +64,10 @@ class NodeOptionReader {
   int integer(const std::string& key, int fallback, int min, int max);
   bool boolean(const std::string& key, bool fallback);
   std::string text(const std::string& key, const std::string& fallback);
+  /// A list of at most @p max_entries strings; empty when absent.
+  /// @throws ParameterError ("~<key>", or "~<key>[i]" for an entry) when it is not a list, is
+  ///         longer, or an entry is not a string
+  std::vector<std::string> textList(const std::string& key, std::size_t max_entries);
   /// The keys of the map parameter @p key, sorted; none when it is absent.
   /// @throws ParameterError ("~<key>") when it is present but not a map
   std::vector<std::string> mapKeys(const std::string& key);

@@ -106,7 +106,8 @@ bool PlantClock::waitingForFollowers(const ros::WallTime& now) {
   if (!waiting_for_followers_) {
     return false;
   }
-  // Simulated time starts once every follower listens, or ~wait_for_followers s after start.
+  // Simulated time starts once every follower listens and every topic waited for has a
+  // subscriber, or ~wait_for_followers s after start.
   const std::pair<int, int> listening = hooks_.listening();
   const double waited = (now - wall_origin_).toSec();
   const bool all = listening.first == listening.second;
@@ -115,12 +116,14 @@ bool PlantClock::waitingForFollowers(const ros::WallTime& now) {
   }
   waiting_for_followers_ = false;
   if (all) {
-    ROS_INFO_STREAM(name_ << ": every follower listens after " << waited
-                          << " s: simulated time starts");
+    ROS_INFO_STREAM(name_ << ": every follower listens (and every topic of "
+                             "~wait_for_subscribers has a subscriber) after "
+                          << waited << " s: simulated time starts");
   } else {
     ROS_WARN_STREAM(name_ << ": " << listening.first << " of " << listening.second
-                          << " followers listen after ~wait_for_followers = " << waited
-                          << " s: simulated time starts without the others");
+                          << " followers listening and topics of ~wait_for_subscribers "
+                             "subscribed after ~wait_for_followers = "
+                          << waited << " s: simulated time starts without the others");
   }
   wall_origin_ = now;
   rate_check_wall_ = now;

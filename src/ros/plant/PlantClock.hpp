@@ -30,8 +30,8 @@ namespace projection_collision_avoidance {
 /// senders' clocks.
 ///
 /// Holding simulated time (publish_clock only): with ~wait_for_followers it stays at its start
-/// until every follower listens (or that many wall s have passed), and the wall schedule starts
-/// then; with ~lockstep tick k + 1 waits until the commands answering tick k are in (at most
+/// until every follower listens and every topic of ~wait_for_subscribers has a subscriber (or
+/// that many wall s have passed), and the wall schedule starts then; with ~lockstep tick k + 1 waits until the commands answering tick k are in (at most
 /// ~lockstep_timeout wall s, then it runs without them, counted and reported), the wall schedule
 /// restarting from the wait's end.
 class PlantClock {
@@ -44,8 +44,9 @@ class PlantClock {
     std::function<void(const std::string& why)> stop;
     /// ROS time went back by the amount given (s, negative).
     std::function<void(double jump)> jump;
-    /// ~wait_for_followers: the followers listening to their measurements, and how many there
-    /// are.
+    /// ~wait_for_followers: how many of what simulated time waits for are ready (the followers
+    /// listening to their measurements, the topics of ~wait_for_subscribers subscribed), and
+    /// how many there are.
     std::function<std::pair<int, int>()> listening;
     /// ~lockstep: whether every agent that has commanded answered tick k.
     std::function<bool(long k)> answered;

@@ -1,9 +1,12 @@
 #include "plant/PlantOptions.hpp"
 
 #include <algorithm>
+#include <cstddef>
 #include <limits>
 #include <string>
 #include <vector>
+
+#include <ros/names.h>
 
 #include "projection_collision_avoidance/core/ParameterError.hpp"
 
@@ -20,6 +23,8 @@ std::string frameParameter(NodeOptionReader& reader, const std::string& key,
 }
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+/// Most entries of ~wait_for_subscribers.
+constexpr std::size_t kMaxWaitedTopics = 1024;
 constexpr double kTwoPi = 6.283185307179586476925286766559;
 
 /// The agents' names of @p scenario: "leader", then "follower" or "follower_1" .. "follower_N".
@@ -164,6 +169,19 @@ PlantNodeOptions readPlantOptions(NodeOptionReader& reader, const Scenario& scen
   }
   o.duration = reader.number("duration", 0.0, 0.0, 1e7);
   o.wait_for_followers = reader.number("wait_for_followers", 0.0, 0.0, 3600.0);
+  o.wait_for_subscribers = reader.textList("wait_for_subscribers", kMaxWaitedTopics);
+  for (std::size_t i = 0; i < o.wait_for_subscribers.size(); ++i) {
+    std::string why;
+    if (!ros::names::validate(o.wait_for_subscribers[i], why)) {
+      throw ParameterError("~wait_for_subscribers[" + std::to_string(i) + "]",
+                           "must be a topic name: " + why);
+    }
+  }
+  if (!o.wait_for_subscribers.empty() && !(o.publish_clock && o.wait_for_followers > 0.0)) {
+    throw ParameterError("~wait_for_subscribers",
+                         "needs ~publish_clock and ~wait_for_followers > 0 (the longest wait, in "
+                         "wall s): only a plant that drives simulated time can hold it");
+  }
   o.lockstep = reader.boolean("lockstep", false);
   o.lockstep_timeout = reader.number("lockstep_timeout", o.lockstep_timeout, 0.001, 3600.0);
   if (o.lockstep && !o.publish_clock) {

@@ -3,6 +3,7 @@
 #include <limits>
 #include <map>
 #include <string>
+#include <vector>
 
 #include "projection_collision_avoidance/ros/RosParameters.hpp"
 #include "projection_collision_avoidance/sim/MeasurementChannel.hpp"
@@ -51,6 +52,9 @@ struct PlantNodeOptions {
   /// Wall s for which, with publish_clock, simulated time stays at its start until every
   /// follower subscribes its relative_measurement (a large formation loading); 0 = no wait.
   double wait_for_followers = 0.0;
+  /// Topics (resolved in the plant's namespace) that, with wait_for_followers, must each have a
+  /// subscriber at the master too before simulated time starts: a test's observers, say.
+  std::vector<std::string> wait_for_subscribers;
   /// With publish_clock: tick k + 1 waits (wall time, at most lockstep_timeout s) until every
   /// agent that has commanded answered tick k with a command stamped t_k, and integrates
   /// [t_k, t_k+1] with those commands: the sampled loop of cf_sim, however loaded the machine.

@@ -10,6 +10,7 @@
 #include <boost/make_shared.hpp>
 #include <geometry_msgs/TransformStamped.h>
 #include <nav_msgs/Odometry.h>
+#include <ros/master.h>
 #include <rosgraph_msgs/Clock.h>
 #include <tf2_eigen/tf2_eigen.h>
 #include <visualization_msgs/MarkerArray.h>
@@ -26,6 +27,8 @@ namespace {
 constexpr double kMarkerRate = 20.0;
 /// Wall seconds between the last tick's messages and the shutdown, to let them out.
 constexpr double kShutdownDelay = 0.25;
+/// Wall seconds between two queries of the master for ~wait_for_subscribers.
+constexpr double kTopicPollPeriod = 0.05;
 
 }  // namespace
 
@@ -118,6 +121,9 @@ PlantWorld::PlantWorld(ros::NodeHandle nh, ros::NodeHandle private_nh)
       restart(follower.agent);
     }
   };
+  for (const std::string& topic : options_.wait_for_subscribers) {
+    waited_topics_.push_back(nh_.resolveName(topic));
+  }
   hooks.listening = [this] {
     int listening = 0;
     for (const Follower& follower : followers_) {
@@ -127,7 +133,8 @@ PlantWorld::PlantWorld(ros::NodeHandle nh, ros::NodeHandle private_nh)
           vehicle != nullptr ? vehicle->driven() : follower.measurement_publisher.subscribed();
       listening += listens ? 1 : 0;
     }
-    return std::make_pair(listening, static_cast<int>(followers_.size()));
+    return std::make_pair(listening + subscribedWaitedTopics(),
+                          static_cast<int>(followers_.size() + waited_topics_.size()));
   };
   hooks.answered = [this](long k) { return commandsAnswer(k); };
   hooks.before_tick = [this] { command_queue_.callAvailable(); };
@@ -148,6 +155,43 @@ PlantWorld::PlantWorld(ros::NodeHandle nh, ros::NodeHandle private_nh)
     summary << ", for " << options_.duration << " s";
   }
   ROS_INFO_STREAM(summary.str());
+}
+
+int PlantWorld::subscribedWaitedTopics() {
+  if (waited_topics_.empty()) {
+    return 0;
+  }
+  // The master's registrations, at most every kTopicPollPeriod (the wait polls far faster).
+  const ros::WallTime now = ros::WallTime::now();
+  if (!topics_polled_.isZero() && (now - topics_polled_).toSec() < kTopicPollPeriod) {
+    return subscribed_topics_;
+  }
+  topics_polled_ = now;
+  XmlRpc::XmlRpcValue request;
+  XmlRpc::XmlRpcValue response;
+  XmlRpc::XmlRpcValue state;
+  request[0] = name_;
+  if (!ros::master::execute("getSystemState", request, response, state, false) ||
+      state.getType() != XmlRpc::XmlRpcValue::TypeArray || state.size() < 2 ||
+      state[1].getType() != XmlRpc::XmlRpcValue::TypeArray) {
+    return subscribed_topics_;  // no answer: as before
+  }
+  // state[1]: the subscriptions, [[topic, [node, ...]], ...].
+  int subscribed = 0;
+  for (const std::string& topic : waited_topics_) {
+    for (int i = 0; i < state[1].size(); ++i) {
+      XmlRpc::XmlRpcValue& entry = state[1][i];
+      if (entry.getType() == XmlRpc::XmlRpcValue::TypeArray && entry.size() == 2 &&
+          entry[0].getType() == XmlRpc::XmlRpcValue::TypeString &&
+          static_cast<std::string>(entry[0]) == topic &&
+          entry[1].getType() == XmlRpc::XmlRpcValue::TypeArray && entry[1].size() > 0) {
+        ++subscribed;
+        break;
+      }
+    }
+  }
+  subscribed_topics_ = subscribed;
+  return subscribed;
 }
 
 void PlantWorld::attachVehicle(Agent* agent) {

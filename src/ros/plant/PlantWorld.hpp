@@ -98,6 +98,9 @@ class PlantWorld {
     CountedPublisher measurement_publisher;
   };
 
+  /// ~wait_for_subscribers: how many of its topics have a subscriber at the master (queried at
+  /// most every 50 wall ms; the last answer between).
+  int subscribedWaitedTopics();
   /// Makes @p agent the vehicle ~vehicles asks for, if any (from its initial state).
   void attachVehicle(Agent* agent);
   /// Advertises the agent's outputs and subscribes its command input.
@@ -149,6 +152,9 @@ class PlantWorld {
   tf2_ros::TransformBroadcaster tf_broadcaster_;
   tf2_ros::StaticTransformBroadcaster static_broadcaster_;  ///< world -> the vehicles' odom frames
   ros::WallTimer shutdown_timer_;
+  std::vector<std::string> waited_topics_;  ///< ~wait_for_subscribers, resolved
+  ros::WallTime topics_polled_;             ///< when the master was last asked
+  int subscribed_topics_ = 0;               ///< its answer then
   std::unique_ptr<PlantClock> clock_;  ///< started last
 };
 
