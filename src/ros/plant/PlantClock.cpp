@@ -141,8 +141,7 @@ bool PlantClock::holdForCommands(const ros::WallTime& now) {
   }
   if ((now - hold_start_).toSec() < options_.lockstep_timeout) {
     // Simulated time waits: the wall schedule restarts from here.
-    const double wall_rate = options_.rate * options_.real_time_factor;
-    wall_origin_ = now - ros::WallDuration(static_cast<double>(next_tick_) / wall_rate);
+    wall_origin_ = now - ros::WallDuration(static_cast<double>(next_tick_) / wallRate(now));
     return true;
   }
   holding_ = false;
@@ -154,6 +153,21 @@ bool PlantClock::holdForCommands(const ros::WallTime& now) {
   return false;
 }
 
+double PlantClock::wallRate(const ros::WallTime& now) {
+  const double factor = options_.lockstep && !hooks_.all_commanded()
+                            ? std::min(1.0, options_.real_time_factor)
+                            : options_.real_time_factor;
+  if (factor != factor_) {
+    // The schedule goes on from the tick due now, at the new pace.
+    if (factor_ > 0.0) {
+      wall_origin_ = now - ros::WallDuration(static_cast<double>(next_tick_) /
+                                             (options_.rate * factor));
+    }
+    factor_ = factor;
+  }
+  return options_.rate * factor_;
+}
+
 void PlantClock::onWallTick(const ros::WallTimerEvent& /*event*/) {
   const std::lock_guard<std::mutex> lock(*mutex_);
   if (!running_) {
@@ -163,11 +177,11 @@ void PlantClock::onWallTick(const ros::WallTimerEvent& /*event*/) {
   // runs late catches up the ticks due since (at most kMaxCatchUp s of them at once), so that
   // simulated time keeps the real-time factor on average; a backlog beyond that is dropped
   // (simulated time slows down) and reported below.
-  const double wall_rate = options_.rate * options_.real_time_factor;
   const ros::WallTime now = ros::WallTime::now();
   if (waitingForFollowers(now)) {
     return;
   }
+  const double wall_rate = wallRate(now);
   long due =
       static_cast<long>(std::floor((now - wall_origin_).toSec() * wall_rate + kTickTolerance));
   const long max_catch_up = std::max(1L, std::lround(kMaxCatchUp * wall_rate));
@@ -180,9 +194,9 @@ void PlantClock::onWallTick(const ros::WallTimerEvent& /*event*/) {
   const double wall = (now - rate_check_wall_).toSec();
   if (wall >= 5.0) {
     const double factor = static_cast<double>(next_tick_ - rate_check_tick_) / options_.rate / wall;
-    if (factor < 0.9 * options_.real_time_factor) {
+    if (factor < 0.9 * factor_) {
       ROS_WARN_STREAM(name_ << ": simulating at " << factor << "x real time, below the "
-                            << options_.real_time_factor << "x asked for");
+                            << factor_ << "x asked for");
     }
     rate_check_wall_ = now;
     rate_check_tick_ = next_tick_;

@@ -33,7 +33,8 @@ namespace projection_collision_avoidance {
 /// until every follower listens and every topic of ~wait_for_subscribers has a subscriber (or
 /// that many wall s have passed), and the wall schedule starts then; with ~lockstep tick k + 1 waits until the commands answering tick k are in (at most
 /// ~lockstep_timeout wall s, then it runs without them, counted and reported), the wall schedule
-/// restarting from the wait's end.
+/// restarting from the wait's end; until every agent with a sender has commanded it runs at most
+/// at real time.
 class PlantClock {
  public:
   /// What the clock asks of the plant and tells it.
@@ -50,6 +51,9 @@ class PlantClock {
     std::function<std::pair<int, int>()> listening;
     /// ~lockstep: whether every agent that has commanded answered tick k.
     std::function<bool(long k)> answered;
+    /// ~lockstep: whether every agent with a sender has commanded; until then simulated time
+    /// runs at most at real time (the nodes still starting join at the pace they would).
+    std::function<bool()> all_commanded;
     /// On wall time (ticksOnThread()): runs on the tick thread before each tick, without the
     /// mutex (the commands received since the tick before). May be empty.
     std::function<void()> before_tick;
@@ -95,6 +99,9 @@ class PlantClock {
   bool waitingForFollowers(const ros::WallTime& now);
   /// ~lockstep: whether tick next_tick_ waits for the commands at wall time @p now.
   bool holdForCommands(const ros::WallTime& now);
+  /// publish_clock: ticks per wall second now (~real_time_factor, or at most real time in
+  /// lockstep until every agent has commanded); moves the wall schedule at a change, at @p now.
+  double wallRate(const ros::WallTime& now);
 
   std::string name_;
   PlantNodeOptions options_;
@@ -112,6 +119,7 @@ class PlantClock {
   ros::WallTime hold_start_;
   std::uint64_t lockstep_timeouts_ = 0;  ///< ticks that ran without every command
   double dropped_seconds_ = 0.0;         ///< wall time: backlog dropped so far (s)
+  double factor_ = 0.0;  ///< publish_clock: the real-time factor the schedule runs at
   ros::WallTime rate_check_wall_;
   long rate_check_tick_ = 0;
   ros::WallTimer wall_timer_;

@@ -84,6 +84,11 @@ class PlantVehicle {
   /// Lockstep: whether the vehicle answered the sample stamped @p sample: a command received at
   /// plant time @p sample or later, no command yet, or nobody publishing cmd_vel or
   /// cmd_vel_stamped.
+  /// Lockstep: whether it has been commanded, or nobody publishes cmd_vel or cmd_vel_stamped.
+  bool commanded() const {
+    return have_command_ ||
+           (twist_subscriber_.getNumPublishers() == 0 && stamped_subscriber_.getNumPublishers() == 0);
+  }
   bool answered(const ros::Time& sample) const {
     return !have_command_ || received_ >= sample ||
            (twist_subscriber_.getNumPublishers() == 0 && stamped_subscriber_.getNumPublishers() == 0);

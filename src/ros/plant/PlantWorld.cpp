@@ -129,14 +129,18 @@ PlantWorld::PlantWorld(ros::NodeHandle nh, ros::NodeHandle private_nh)
     for (const Follower& follower : followers_) {
       // A vehicle's follower listens to odometry and drives it through cmd_vel.
       const PlantVehicle* vehicle = follower.agent.vehicle.get();
-      const bool listens =
-          vehicle != nullptr ? vehicle->driven() : follower.measurement_publisher.subscribed();
+      // A double integrator's follower takes its relative_measurement, or its odometry
+      // (~input odometry).
+      const bool listens = vehicle != nullptr ? vehicle->driven()
+                                              : follower.measurement_publisher.subscribed() ||
+                                                    follower.agent.odom_publisher.subscribed();
       listening += listens ? 1 : 0;
     }
     return std::make_pair(listening + subscribedWaitedTopics(),
                           static_cast<int>(followers_.size() + waited_topics_.size()));
   };
   hooks.answered = [this](long k) { return commandsAnswer(k); };
+  hooks.all_commanded = [this] { return everyAgentCommanded(); };
   hooks.before_tick = [this] { command_queue_.callAvailable(); };
   clock_ = std::make_unique<PlantClock>(nh_, name_, options_, &mutex_, std::move(hooks));
   std::ostringstream summary;
@@ -341,6 +345,18 @@ bool PlantWorld::commandsAnswer(long k) const {
   return answered(leader_) &&
          std::all_of(followers_.begin(), followers_.end(),
                      [&](const Follower& follower) { return answered(follower.agent); });
+}
+
+bool PlantWorld::everyAgentCommanded() const {
+  const auto commanded = [](const Agent& agent) {
+    if (agent.vehicle) {
+      return agent.vehicle->commanded();
+    }
+    return agent.command_guard.haveAccepted() || agent.command_subscriber.getNumPublishers() == 0;
+  };
+  return commanded(leader_) &&
+         std::all_of(followers_.begin(), followers_.end(),
+                     [&](const Follower& follower) { return commanded(follower.agent); });
 }
 
 void PlantWorld::advanceAgent(Agent* agent, double t, const ros::Time& stamp) {

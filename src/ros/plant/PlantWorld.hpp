@@ -56,7 +56,8 @@ namespace projection_collision_avoidance {
 /// received after sample k went out.
 ///
 /// Time: PlantClock. With publish_clock the plant owns simulated time (stamps t_k from 0), ticking
-/// on a wall timer at rate * real_time_factor (catching up ticks that a late callback missed).
+/// on a wall timer at rate * real_time_factor (catching up ticks that a late callback missed; in
+/// lockstep at most at real time until every agent with a sender has commanded).
 /// Otherwise it ticks on ROS time, catching up every tick that is due; scenario time is ROS time
 /// under use_sim_time and the time since the first tick otherwise.
 class PlantWorld {
@@ -123,6 +124,8 @@ class PlantWorld {
   /// Lockstep: whether every agent that has commanded and still has a sender answered sample k:
   /// a command stamped at or after t_k (a vehicle: a Twist received after sample k went out).
   bool commandsAnswer(long k) const;
+  /// Lockstep: whether every agent with a sender on its command topic has commanded.
+  bool everyAgentCommanded() const;
   void publishMarkers(const ros::Time& stamp);
   /// The agent a follower is measured against.
   const Agent& targetOf(const Follower& follower) const;
