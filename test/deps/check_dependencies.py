@@ -56,6 +56,7 @@ WRAPPERS = {"exec": (0, set()), "sudo": (0, {"-u", "-g"}), "nohup": (0, set()),
 # Scripts that build, test and measure the package: what only they use may be a test_depend.
 DEVELOPMENT_SCRIPTS = {"scripts/test.sh", "scripts/build.sh", "scripts/sanitize.sh",
                        "scripts/setup.sh", "scripts/check_workspace.sh", "scripts/workspace.sh",
+                       "scripts/quick_test.sh",
                        "experiments/flaky_tests/run.sh", "experiments/flaky_tests/flaky_tests.py",
                        "experiments/ci_time/run.sh", "experiments/ci_time/ci_phases.py",
                        "experiments/performance/run.sh",

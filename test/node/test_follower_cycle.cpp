@@ -81,10 +81,14 @@ TEST(FollowerCycle, TheControlThreadAllocatesAndFreesNothing) {
   Handoff<FollowerCycleOutput, 64> outputs;
   constexpr int kTicks = 12000;
   std::atomic<std::int64_t> clock{kStart};
+  std::atomic<std::int64_t> inputs_at{0};  // the latest clock reading the inputs thread answered
   std::atomic<bool> done{false};
 
   // The subscriber's side: measurements (with a 1 s outage from tick 4000), leader broadcasts and
-  // the own odometry.
+  // the own odometry. It writes while the control thread ticks; the control thread lets it fall
+  // at most kLagTicks behind, so that how the two are scheduled (a loaded machine can hold one
+  // thread off for tens of milliseconds) cannot age the inputs into a timeout.
+  constexpr std::int64_t kLagTicks = 5;
   std::thread inputs([&] {
     std::uint64_t sequence = 0;
     std::int64_t last = 0;
@@ -99,7 +103,10 @@ TEST(FollowerCycle, TheControlThreadAllocatesAndFreesNothing) {
         leader.acceleration.setConstant(1, -0.5);
         cycle->leader().write(leader);
         cycle->ownState().write(ownStateAt(now, sequence, 1.0 + 0.1 * std::cos(1e-9 * now)));
+      }
+      if (now != last) {
         last = now;
+        inputs_at.store(now);
       }
       std::this_thread::yield();
     }
@@ -131,6 +138,9 @@ TEST(FollowerCycle, TheControlThreadAllocatesAndFreesNothing) {
     const long allocations_before = testing::threadAllocationCount();
     const long frees_before = testing::threadFreeCount();
     for (int k = 1; k <= kTicks; ++k) {
+      while (inputs_at.load() < clock.load() - kLagTicks * kMs) {
+        std::this_thread::yield();
+      }
       const std::int64_t now = clock.fetch_add(kMs) + kMs;
       if (k == 6000) {
         cycle->offer(std::move(offered));  // built on another thread; adopted by a tick
