@@ -37,7 +37,11 @@ if [[ -z $build ]]; then
   # A colcon workspace outside the package, as scripts/test.sh builds it; kept for the next run.
   workspaces=${TMPDIR:-/tmp}/projection_collision_avoidance-flaky
   build=$workspaces/colcon/build/projection_collision_avoidance
-  if [[ ! -f $build/CTestTestfile.cmake ]]; then
+  if [[ -f $build/CTestTestfile.cmake ]]; then
+    echo "flaky_tests: rebuilding what changed in $workspaces/colcon"
+    make -C "$build" -j"$(nproc)" all tests >"$workspaces/colcon/rebuild.log" 2>&1 || {
+      tail -40 "$workspaces/colcon/rebuild.log"; echo "flaky_tests: the build failed"; exit 1; }
+  else
     echo "flaky_tests: building the package and its tests in $workspaces/colcon"
     build=$("$root/scripts/workspace.sh" colcon "$workspaces" --tests)
   fi
