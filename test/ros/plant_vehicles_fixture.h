@@ -39,8 +39,9 @@ inline double angleBetween(double a, double b) { return std::remainder(a - b, 2.
 
 /// One odometry message.
 struct OdomSample {
-  double t = 0.0;       ///< stamp (s; about 0.2 µs resolution at today's epoch times)
-  std::int64_t ns = 0;  ///< stamp (ns), for exact differences
+  double t = 0.0;         ///< stamp (s; about 0.2 µs resolution at today's epoch times)
+  std::int64_t ns = 0;    ///< stamp (ns), for exact differences
+  std::uint32_t seq = 0;  ///< header.seq: roscpp numbers every message its publisher sends
   Eigen::Vector3d position = Eigen::Vector3d::Zero();
   double yaw = 0.0;
   double quaternion_norm = 0.0;
@@ -63,6 +64,7 @@ inline OdomSample sampleOf(const nav_msgs::Odometry& msg) {
   OdomSample s;
   s.t = msg.header.stamp.toSec();
   s.ns = static_cast<std::int64_t>(msg.header.stamp.toNSec());
+  s.seq = msg.header.seq;
   const auto& p = msg.pose.pose.position;
   const auto& q = msg.pose.pose.orientation;
   s.position = Eigen::Vector3d(p.x, p.y, p.z);
@@ -101,6 +103,18 @@ struct AgentRecord {
   }
 
   double lastTime() const { return odom.empty() ? -1.0 : odom.rbegin()->second.t; }
+
+  /// The first odometry sample published at least @p messages after @p from (the plant publishes
+  /// one per tick, so these are ticks of integration, whatever the stamps say: a plant on wall
+  /// time that falls behind drops ticks and its stamps jump), or nullptr.
+  const OdomSample* messagesAfter(const OdomSample& from, long messages) const {
+    for (auto it = odom.find(from.ns); it != odom.end(); ++it) {
+      if (static_cast<long>(it->second.seq - from.seq) >= messages) {
+        return &it->second;
+      }
+    }
+    return nullptr;
+  }
 
   /// The odometry sample whose stamp is nearest @p t (s).
   const OdomSample& nearest(double t) const {
