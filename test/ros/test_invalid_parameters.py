@@ -35,7 +35,12 @@ import yaml
 from ros_test_helpers import node_executable
 
 PACKAGE = "projection_collision_avoidance"
-DEADLINE = 10.0  # wall seconds for a node to give up on a bad parameter (or to start)
+# Wall seconds for a node to exit on a bad parameter or log that it runs, and to exit after
+# SIGINT (~deadline, ~stop_deadline): bounds that only a hang reaches. A node takes well under a
+# second for either, but twelve starting at once on a loaded 2-core machine took over 10 s to
+# start and over 5 s to stop.
+DEADLINE = 60.0
+STOP_DEADLINE = 30.0
 PARALLEL = 12  # node processes at a time (they mostly wait on the master, not on a CPU)
 
 FOLLOWER, PLANT, LEADER = "follower_node", "plant_node", "leader_node"
@@ -726,7 +731,9 @@ NODE_OPTIONS = [
     opt("share_disturbance an integer", LEADER, "share_disturbance", 0),
 ]
 
-Result = collections.namedtuple("Result", "outcome code output seconds")
+# outcome: "exited", "running" or "hung"; stopped: after "running", whether SIGINT ended it
+# within STOP_DEADLINE (else it was killed).
+Result = collections.namedtuple("Result", "outcome code output seconds stopped")
 
 
 class InvalidParameters(unittest.TestCase):
@@ -774,10 +781,11 @@ class InvalidParameters(unittest.TestCase):
         return name
 
     @staticmethod
-    def run_node(executable, name, deadline=DEADLINE, prefix=()):
+    def run_node(executable, name, deadline=None, prefix=()):
         """Runs a node (after the command @p prefix, if any) until it exits, logs that it runs
         (then it is stopped) or the deadline passes (then it is killed). The outcome is
         "exited", "running" or "hung"."""
+        deadline = DEADLINE if deadline is None else deadline
         start = time.monotonic()
         # Line-buffered stdout, so that "running" is seen as soon as it is logged.
         environment = dict(os.environ, ROSCONSOLE_STDOUT_LINE_BUFFERED="1")
@@ -804,15 +812,17 @@ class InvalidParameters(unittest.TestCase):
                 outcome = "running"
                 break
         seconds = time.monotonic() - start
+        stopped = True
         if outcome != "exited":
             process.send_signal(signal.SIGINT)
             try:
-                process.wait(timeout=5.0)
+                process.wait(timeout=STOP_DEADLINE)
             except subprocess.TimeoutExpired:
+                stopped = False
                 process.kill()
                 process.wait()
         reader.join(timeout=5.0)
-        return Result(outcome, process.returncode, "".join(lines), seconds)
+        return Result(outcome, process.returncode, "".join(lines), seconds, stopped)
 
     def run_cases(self, cases, prefix=()):
         """Runs every (case, node) pair, several at a time, each after the command @p prefix;
@@ -993,6 +1003,9 @@ class InvalidParameters(unittest.TestCase):
             if r.outcome != "running":
                 failures.append(f"[{node}] {c.name}: {r.outcome} (exit status {r.code}) instead "
                                 f"of running\n{r.output.rstrip()}")
+            elif not r.stopped:
+                failures.append(f"[{node}] {c.name}: still running {STOP_DEADLINE} s after "
+                                f"SIGINT\n{r.output.rstrip()[-2000:]}")
             elif r.code < 0 or r.code in (134, 139):
                 failures.append(f"[{node}] {c.name}: crashed on SIGINT (exit status {r.code})")
         if failures:
@@ -1001,4 +1014,6 @@ class InvalidParameters(unittest.TestCase):
 
 if __name__ == "__main__":
     rospy.init_node("test_invalid_parameters", anonymous=True)
+    DEADLINE = rospy.get_param("~deadline", DEADLINE)
+    STOP_DEADLINE = rospy.get_param("~stop_deadline", STOP_DEADLINE)
     rostest.rosrun(PACKAGE, "invalid_parameters", InvalidParameters, sys.argv)
