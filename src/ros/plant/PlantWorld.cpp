@@ -219,6 +219,21 @@ void PlantWorld::connectAgent(Agent* agent) {
     if (agent->vehicle->odomFrameTransform(plantNow(), &odom_frame)) {
       static_broadcaster_.sendTransform(odom_frame);  // latched: one per vehicle, kept
     }
+    if (options_.lockstep) {
+      ros::SubscribeOptions watch;
+      watch.init<geometry_msgs::AccelStamped>(
+          agent->name + "/command", 10,
+          [this, agent](const geometry_msgs::AccelStamped::ConstPtr& msg) {
+            const std::lock_guard<std::mutex> lock(mutex_);
+            agent->controller_stamp =
+                std::max(agent->controller_stamp, nanosecondsOf(msg->header.stamp));
+          });
+      watch.transport_hints = ros::TransportHints().tcpNoDelay();
+      if (PlantClock::ticksOnThread(options_)) {
+        watch.callback_queue = &command_queue_;
+      }
+      agent->controller_subscriber = nh_.subscribe(watch);
+    }
     return;
   }
   agent->odom_publisher.advertise<nav_msgs::Odometry>(nh_, agent->name + "/odom", 10);
@@ -334,13 +349,16 @@ bool PlantWorld::commandsAnswer(long k) const {
   const std::int64_t due = nanosecondsOf(due_time);
   // Waited for: an agent that has commanded and still has a sender (one that was stopped, or
   // whose node ended, holds nobody up); it answers with a command stamped at t_k or later (a
-  // vehicle's Twist carries no stamp: one received after sample k went out).
+  // vehicle's Twist carries no stamp: one received after sample k went out; and the controller
+  // behind its adapter, when there is one, with a command stamped at t_k or later).
   const auto answered = [due, &due_time](const Agent& agent) {
     if (agent.vehicle) {
-      return agent.vehicle->answered(due_time);
+      return agent.vehicle->answered(due_time) &&
+             (agent.controller_stamp < 0 || agent.controller_subscriber.getNumPublishers() == 0 ||
+              agent.controller_stamp >= due);
     }
-    return !agent.command_guard.haveAccepted() || agent.command_subscriber.getNumPublishers() == 0 ||
-           agent.command_stamp >= due;
+    return !agent.command_guard.haveAccepted() ||
+           agent.command_subscriber.getNumPublishers() == 0 || agent.command_stamp >= due;
   };
   return answered(leader_) &&
          std::all_of(followers_.begin(), followers_.end(),

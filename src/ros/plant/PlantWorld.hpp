@@ -85,6 +85,11 @@ class PlantWorld {
     CountedPublisher odom_publisher;
     CountedPublisher applied_command_publisher;  ///< the command integrated over each tick
     std::unique_ptr<PlantVehicle> vehicle;       ///< a vehicle kind; null: the double integrator
+    /// Lockstep with a vehicle: the controller's output (agent/command, which an adapter turns
+    /// into cmd_vel) is watched too, so that a vehicle answers a tick once its controller has:
+    /// the latest stamp seen there (ns; -1: none yet).
+    std::int64_t controller_stamp = -1;
+    ros::Subscriber controller_subscriber;
 
     /// [p; v] of the agent (2 axes entries).
     Eigen::VectorXd state() const {
@@ -158,7 +163,7 @@ class PlantWorld {
   std::vector<std::string> waited_topics_;  ///< ~wait_for_subscribers, resolved
   ros::WallTime topics_polled_;             ///< when the master was last asked
   int subscribed_topics_ = 0;               ///< its answer then
-  std::unique_ptr<PlantClock> clock_;  ///< started last
+  std::unique_ptr<PlantClock> clock_;       ///< started last
 };
 
 }  // namespace projection_collision_avoidance
