@@ -29,6 +29,9 @@ import re
 import sys
 import xml.etree.ElementTree as ET
 
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "common"))
+from doc_block import replace_block  # noqa: E402 (from experiments/common/)
+
 PHASE = re.compile(r"^== phase (?P<name>.+) \(at (?P<at>\d+) s\)\s*$")
 STAMPED = re.compile(r"^(?P<epoch>\d{10}) (?P<text>.*)$")
 # Phase starts in the output of scripts/test.sh before it printed its own times.
@@ -167,13 +170,7 @@ def report(args):
     if not args.update:
         print(text)
         return
-    doc = pathlib.Path(args.update)
-    content = doc.read_text()
-    if BEGIN not in content or END not in content:
-        sys.exit(f"{doc}: no markers {BEGIN} ... {END}")
-    head, rest = content.split(BEGIN, 1)
-    _, tail = rest.split(END, 1)
-    doc.write_text(f"{head}{BEGIN}\n{text}\n{END}{tail}")
+    replace_block(args.update, BEGIN, END, text)
 
 
 def main():

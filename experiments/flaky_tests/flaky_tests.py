@@ -16,6 +16,9 @@ import re
 import sys
 import xml.etree.ElementTree as ET
 
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "common"))
+from doc_block import replace_block  # noqa: E402 (from experiments/common/)
+
 BEGIN = "<!-- flaky-tests: begin (experiments/flaky_tests/run.sh) -->"
 END = "<!-- flaky-tests: end -->"
 TOTAL = re.compile(r"Total Test time \(real\) = +(?P<seconds>[0-9.]+) sec")
@@ -85,13 +88,7 @@ def main():
     text = "\n".join(lines)
     print(text)
     if args.update:
-        doc = pathlib.Path(args.update)
-        content = doc.read_text()
-        if BEGIN not in content or END not in content:
-            sys.exit(f"{doc}: no markers {BEGIN} ... {END}")
-        head, rest = content.split(BEGIN, 1)
-        _, tail = rest.split(END, 1)
-        doc.write_text(f"{head}{BEGIN}\n{text}\n{END}{tail}")
+        replace_block(args.update, BEGIN, END, text)
 
 
 if __name__ == "__main__":
