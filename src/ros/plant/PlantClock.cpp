@@ -160,8 +160,8 @@ double PlantClock::wallRate(const ros::WallTime& now) {
   if (factor != factor_) {
     // The schedule goes on from the tick due now, at the new pace.
     if (factor_ > 0.0) {
-      wall_origin_ = now - ros::WallDuration(static_cast<double>(next_tick_) /
-                                             (options_.rate * factor));
+      wall_origin_ =
+          now - ros::WallDuration(static_cast<double>(next_tick_) / (options_.rate * factor));
     }
     factor_ = factor;
   }
@@ -195,8 +195,8 @@ void PlantClock::onWallTick(const ros::WallTimerEvent& /*event*/) {
   if (wall >= 5.0) {
     const double factor = static_cast<double>(next_tick_ - rate_check_tick_) / options_.rate / wall;
     if (factor < 0.9 * factor_) {
-      ROS_WARN_STREAM(name_ << ": simulating at " << factor << "x real time, below the "
-                            << factor_ << "x asked for");
+      ROS_WARN_STREAM(name_ << ": simulating at " << factor << "x real time, below the " << factor_
+                            << "x asked for");
     }
     rate_check_wall_ = now;
     rate_check_tick_ = next_tick_;

@@ -31,10 +31,10 @@ namespace projection_collision_avoidance {
 ///
 /// Holding simulated time (publish_clock only): with ~wait_for_followers it stays at its start
 /// until every follower listens and every topic of ~wait_for_subscribers has a subscriber (or
-/// that many wall s have passed), and the wall schedule starts then; with ~lockstep tick k + 1 waits until the commands answering tick k are in (at most
-/// ~lockstep_timeout wall s, then it runs without them, counted and reported), the wall schedule
-/// restarting from the wait's end; until every agent with a sender has commanded it runs at most
-/// at real time.
+/// that many wall s have passed), and the wall schedule starts then; with ~lockstep tick k + 1
+/// waits until the commands answering tick k are in (at most ~lockstep_timeout wall s, then it runs
+/// without them, counted and reported), the wall schedule restarting from the wait's end; until
+/// every agent with a sender has commanded it runs at most at real time.
 class PlantClock {
  public:
   /// What the clock asks of the plant and tells it.

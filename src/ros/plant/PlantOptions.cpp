@@ -172,7 +172,8 @@ PlantNodeOptions readPlantOptions(NodeOptionReader& reader, const Scenario& scen
   o.wait_for_subscribers = reader.textList("wait_for_subscribers", kMaxWaitedTopics);
   for (std::size_t i = 0; i < o.wait_for_subscribers.size(); ++i) {
     std::string why = "empty";
-    if (o.wait_for_subscribers[i].empty() || !ros::names::validate(o.wait_for_subscribers[i], why)) {
+    if (o.wait_for_subscribers[i].empty() ||
+        !ros::names::validate(o.wait_for_subscribers[i], why)) {
       throw ParameterError("~wait_for_subscribers[" + std::to_string(i) + "]",
                            "must be a topic name: " + why);
     }

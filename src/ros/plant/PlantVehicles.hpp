@@ -86,12 +86,13 @@ class PlantVehicle {
   /// cmd_vel_stamped.
   /// Lockstep: whether it has been commanded, or nobody publishes cmd_vel or cmd_vel_stamped.
   bool commanded() const {
-    return have_command_ ||
-           (twist_subscriber_.getNumPublishers() == 0 && stamped_subscriber_.getNumPublishers() == 0);
+    return have_command_ || (twist_subscriber_.getNumPublishers() == 0 &&
+                             stamped_subscriber_.getNumPublishers() == 0);
   }
   bool answered(const ros::Time& sample) const {
     return !have_command_ || received_ >= sample ||
-           (twist_subscriber_.getNumPublishers() == 0 && stamped_subscriber_.getNumPublishers() == 0);
+           (twist_subscriber_.getNumPublishers() == 0 &&
+            stamped_subscriber_.getNumPublishers() == 0);
   }
 
  private:
