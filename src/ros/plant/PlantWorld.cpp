@@ -220,34 +220,33 @@ void PlantWorld::connectAgent(Agent* agent) {
       static_broadcaster_.sendTransform(odom_frame);  // latched: one per vehicle, kept
     }
     if (options_.lockstep) {
-      ros::SubscribeOptions watch;
-      watch.init<geometry_msgs::AccelStamped>(
-          agent->name + "/command", 10,
-          [this, agent](const geometry_msgs::AccelStamped::ConstPtr& msg) {
+      agent->controller_subscriber =
+          subscribeCommand(agent, [this, agent](const geometry_msgs::AccelStamped::ConstPtr& msg) {
             const std::lock_guard<std::mutex> lock(mutex_);
             agent->controller_stamp =
                 std::max(agent->controller_stamp, nanosecondsOf(msg->header.stamp));
           });
-      watch.transport_hints = ros::TransportHints().tcpNoDelay();
-      if (PlantClock::ticksOnThread(options_)) {
-        watch.callback_queue = &command_queue_;
-      }
-      agent->controller_subscriber = nh_.subscribe(watch);
     }
     return;
   }
   agent->odom_publisher.advertise<nav_msgs::Odometry>(nh_, agent->name + "/odom", 10);
   agent->applied_command_publisher.advertise<geometry_msgs::AccelStamped>(
       nh_, agent->name + "/applied_command", 10);
-  ros::SubscribeOptions subscription;
-  subscription.init<geometry_msgs::AccelStamped>(
-      agent->name + "/command", 10,
+  agent->command_subscriber = subscribeCommand(
+      agent,
       [this, agent](const geometry_msgs::AccelStamped::ConstPtr& msg) { onCommand(agent, msg); });
+}
+
+ros::Subscriber PlantWorld::subscribeCommand(
+    Agent* agent,
+    const boost::function<void(const geometry_msgs::AccelStamped::ConstPtr&)>& callback) {
+  ros::SubscribeOptions subscription;
+  subscription.init<geometry_msgs::AccelStamped>(agent->name + "/command", 10, callback);
   subscription.transport_hints = ros::TransportHints().tcpNoDelay();
   if (PlantClock::ticksOnThread(options_)) {
     subscription.callback_queue = &command_queue_;
   }
-  agent->command_subscriber = nh_.subscribe(subscription);
+  return nh_.subscribe(subscription);
 }
 
 void PlantWorld::onCommand(Agent* agent, const geometry_msgs::AccelStamped::ConstPtr& msg) {

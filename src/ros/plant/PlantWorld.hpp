@@ -131,6 +131,11 @@ class PlantWorld {
   bool commandsAnswer(long k) const;
   /// Lockstep: whether every agent with a sender on its command topic has commanded.
   bool everyAgentCommanded() const;
+  /// A subscriber of @p agent's command topic (`<agent>/command`), on the tick thread's queue
+  /// when the plant ticks on a thread of its own.
+  ros::Subscriber subscribeCommand(
+      Agent* agent,
+      const boost::function<void(const geometry_msgs::AccelStamped::ConstPtr&)>& callback);
   void publishMarkers(const ros::Time& stamp);
   /// The agent a follower is measured against.
   const Agent& targetOf(const Follower& follower) const;
