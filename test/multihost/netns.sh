@@ -8,7 +8,11 @@
 
 netns_tag=pca$$
 netns_hosts=()
-netns_made_mount=""
+# Cases run side by side: whether /run/netns was a mount point before any of them is kept in a
+# marker beside it, read and changed under one lock, so the last one out unmounts what the first
+# one in made.
+netns_lock=/run/pca-netns.lock
+netns_marker=/run/pca-netns.made-mount
 
 netns_skip() {
   echo "skipped: $*"
@@ -33,10 +37,15 @@ netns_cleanup() {
     ip netns pids "$ns" 2>/dev/null | xargs -r kill -KILL 2>/dev/null || true
     ip netns del "$ns" 2>/dev/null || true
   done
-  # `ip netns add` made /run/netns a mount point of itself when it was none: undo that too.
-  if [[ -n $netns_made_mount ]] && [[ -z $(ip netns list 2>/dev/null) ]]; then
-    umount /run/netns 2>/dev/null || true
-  fi
+  # `ip netns add` made /run/netns a mount point of itself when it was none: the last one out
+  # undoes that too.
+  (
+    flock 9
+    if [[ -e $netns_marker ]] && [[ -z $(ip netns list 2>/dev/null) ]]; then
+      umount /run/netns 2>/dev/null || true
+      rm -f "$netns_marker"
+    fi
+  ) 9>"$netns_lock"
   [[ -n ${keep_log:-} ]] || rm -rf "$log"
 }
 
@@ -54,10 +63,13 @@ make_hosts() {
   [ "$(id -u)" = 0 ] || netns_skip "not root: network namespaces need CAP_SYS_ADMIN"
   command -v ip >/dev/null || netns_skip "no ip command (iproute2)"
   command -v nsenter >/dev/null || netns_skip "no nsenter command (util-linux)"
-  netns_made_mount=""
-  mountpoint -q /run/netns 2>/dev/null || netns_made_mount=yes
+  command -v flock >/dev/null || netns_skip "no flock command (util-linux)"
   trap netns_cleanup EXIT
-  ip netns add "$world" 2>/dev/null || netns_skip "ip netns add refused here"
+  (
+    flock 9
+    mountpoint -q /run/netns 2>/dev/null || touch "$netns_marker"
+    ip netns add "$world" 2>/dev/null
+  ) 9>"$netns_lock" || netns_skip "ip netns add refused here"
   netns_hosts=("$world")
   netns_ip "$world" link set lo up
   netns_ip "$world" link add br0 type bridge 2>/dev/null || netns_skip "no bridge links here"

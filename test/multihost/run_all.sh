@@ -40,6 +40,9 @@ done
 # $MULTIHOST_JOBS of them run at once.
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
+# The cases must leave the machine as they found it: no namespace of theirs and /run/netns a mount
+# point only if it was one before (a mount left behind keeps CI's root from being removed).
+mounts_before=$(mountpoint -q /run/netns 2>/dev/null && echo mounted || echo none)
 run_case() {
   local name=$1 logdir=$work/$1 start=$SECONDS kind rest
   mkdir -p "$logdir"
@@ -89,9 +92,20 @@ for name in "${order[@]}"; do
   echo "multihost $name: $outcome ($seconds s) [${cases[$name]}]"
   grep -rh "ROS run:\|ROS max" "$logdir/ros" 2>/dev/null | sed 's/.*\(ROS run:\|follower_[0-9]* ->\)/    \1/' | sed 's/\x1b\[[0-9;]*m//g' | sort -u || true
 done
+mounts_after=$(mountpoint -q /run/netns 2>/dev/null && echo mounted || echo none)
+left=$(ip netns list 2>/dev/null | grep -c "^pca" || true)
+if [[ $mounts_after == "$mounts_before" ]] && [[ $left == 0 ]]; then
+  body+="  <testcase classname=\"multihost\" name=\"cleaned_up\" time=\"0\"/>"$'\n'
+  echo "multihost cleaned_up: passed (/run/netns $mounts_after as before, no namespace left)"
+else
+  outcome="/run/netns $mounts_before before and $mounts_after after, $left namespaces left"
+  body+="  <testcase classname=\"multihost\" name=\"cleaned_up\" time=\"0\"><failure message=\"$outcome\"/></testcase>"$'\n'
+  echo "multihost cleaned_up: FAILED ($outcome)"
+  failures=$((failures + 1))
+fi
 {
   echo '<?xml version="1.0" encoding="UTF-8"?>'
-  echo "<testsuite name=\"multihost\" tests=\"${#order[@]}\" failures=\"$failures\" skipped=\"$skipped\" errors=\"0\">"
+  echo "<testsuite name=\"multihost\" tests=\"$((${#order[@]} + 1))\" failures=\"$failures\" skipped=\"$skipped\" errors=\"0\">"
   printf '%s' "$body"
   echo '</testsuite>'
 } >"$xml"
