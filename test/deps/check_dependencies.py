@@ -308,11 +308,12 @@ def check(use, listed, keys):
     return None
 
 
-def write_xunit(path, results):
-    suite = ET.Element("testsuite", name="dependencies", tests=str(len(results)),
+def write_xunit(path, results, suite_name="dependencies"):
+    """Writes (name, problem or None) pairs as one JUnit suite: a test case per pair."""
+    suite = ET.Element("testsuite", name=suite_name, tests=str(len(results)),
                        failures=str(sum(1 for _, problem in results if problem)), errors="0")
     for name, problem in results:
-        case = ET.SubElement(suite, "testcase", classname="dependencies", name=name)
+        case = ET.SubElement(suite, "testcase", classname=suite_name, name=name)
         if problem:
             ET.SubElement(case, "failure", message=problem).text = problem
     os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
