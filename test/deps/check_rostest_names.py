@@ -65,22 +65,19 @@ def main(argv=None):
     ap.add_argument("--xunit", metavar="FILE", help="also write the results as JUnit XML")
     args = ap.parse_args(argv)
 
-    owners = defaultdict(list)
-    results = []
+    owners = defaultdict(list)  # test-name -> the ctest tests that give it
+    loaded = []  # (ctest name, its test-names)
+    checked = []  # (ctest name, problem or None)
     for ctest_name, launch, launch_args in rostest_commands(args.build):
         try:
             names = test_names(launch, launch_args)
         except Exception as error:  # pylint: disable=broad-except
-            results.append((ctest_name, f"{launch} {' '.join(launch_args)} did not load: {error}"))
+            checked.append((ctest_name, f"{launch} {' '.join(launch_args)} did not load: {error}"))
             continue
         for name in names:
             owners[name].append(ctest_name)
-        results.append((ctest_name, names))
-    checked = []
-    for ctest_name, names in results:
-        if isinstance(names, str):
-            checked.append((ctest_name, names))
-            continue
+        loaded.append((ctest_name, names))
+    for ctest_name, names in loaded:
         clashes = sorted({other for name in names for other in owners[name]} - {ctest_name})
         problem = None
         if clashes:
