@@ -3,7 +3,10 @@
 # CMake project test/sanitize/, no catkin), runs the core gtests under them, then fuzzes the
 # controller with libFuzzer for N seconds from a copy of the seed corpus. Exits non-zero on any
 # failure (a failing test, a sanitizer report, a crash or invariant violation found by the fuzzer).
-# Usage: scripts/sanitize.sh [--fuzz-seconds N]   (default 20; 0 skips the fuzz run)
+# Usage: scripts/sanitize.sh [--fuzz-seconds N] [--build-only | --no-build]
+#   --fuzz-seconds N  fuzz for N seconds (default 20; 0 skips the fuzz run)
+#   --build-only      only build; --no-build: only test what an earlier --build-only built
+#                     (scripts/test.sh builds beside its rostests, then tests on a quiet machine)
 # Environment: SANITIZE_BUILD_DIR (default build-sanitize/), CXX (default clang++), JOBS (2).
 # A long fuzz run: scripts/sanitize.sh --fuzz-seconds 3600. A crash leaves its input in
 # $SANITIZE_BUILD_DIR/fuzz/crash-*; replay it with
@@ -13,11 +16,14 @@ set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 build_dir=${SANITIZE_BUILD_DIR:-$root/build-sanitize}
 fuzz_seconds=20
+stages=all
 while [[ $# -gt 0 ]]; do
   case $1 in
     --fuzz-seconds) fuzz_seconds=${2:?--fuzz-seconds needs a value}; shift 2 ;;
     --fuzz-seconds=*) fuzz_seconds=${1#*=}; shift ;;
-    -h|--help) sed -n '2,12p' "$0"; exit 0 ;;
+    --build-only) stages=build; shift ;;
+    --no-build) stages=test; shift ;;
+    -h|--help) sed -n '2,15p' "$0"; exit 0 ;;
     *) echo "sanitize: unknown argument $1" >&2; exit 2 ;;
   esac
 done
@@ -29,27 +35,35 @@ if symbolizer=$(command -v llvm-symbolizer); then
   export ASAN_SYMBOLIZER_PATH=$symbolizer
 fi
 
-# phase NAME: "== phase NAME (at S s)", S from the first phase of this run (PCA_PHASE_EPOCH,
-# shared with scripts/test.sh).
+# phase NAME: "== phase [LANE] NAME (at S s)", S from the first phase of this run
+# (PCA_PHASE_EPOCH, shared with scripts/test.sh), [LANE] when PCA_PHASE_LANE names the lane of a
+# run beside another (scripts/test.sh).
 phase() {
   export PCA_PHASE_EPOCH=${PCA_PHASE_EPOCH:-$(date +%s)}
-  echo "== phase $1 (at $(($(date +%s) - PCA_PHASE_EPOCH)) s)"
+  echo "== phase ${PCA_PHASE_LANE:+[$PCA_PHASE_LANE] }$1 (at $(($(date +%s) - PCA_PHASE_EPOCH)) s)"
 }
 
-phase "sanitizers: build"
-echo "ASan + UBSan, clang, in $build_dir"
-start=$SECONDS
-# Through ccache when there is one (a rebuild of the same sources comes out of the cache).
-launcher=()
-command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
-cmake -S "$root/test/sanitize" -B "$build_dir" -DCMAKE_CXX_COMPILER="${CXX:-clang++}" \
-  "${launcher[@]}" >/dev/null
-make -C "$build_dir" -j"${JOBS:-2}" >"$build_dir/build.log" 2>&1 || {
-  tail -40 "$build_dir/build.log"
-  echo "sanitize: build failed (log: $build_dir/build.log)"
-  exit 1
+# The core, its gtests and the fuzzer, built with the sanitizers.
+build_sanitized() {
+  phase "sanitizers: build"
+  echo "ASan + UBSan, clang, in $build_dir"
+  local start=$SECONDS launcher=()
+  # Through ccache when there is one (a rebuild of the same sources comes out of the cache).
+  command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+  cmake -S "$root/test/sanitize" -B "$build_dir" -DCMAKE_CXX_COMPILER="${CXX:-clang++}" \
+    "${launcher[@]}" >/dev/null
+  make -C "$build_dir" -j"${JOBS:-2}" >"$build_dir/build.log" 2>&1 || {
+    tail -40 "$build_dir/build.log"
+    echo "sanitize: build failed (log: $build_dir/build.log)"
+    exit 1
+  }
+  echo "built in $((SECONDS - start)) s"
 }
-echo "built in $((SECONDS - start)) s"
+
+[[ $stages == test ]] || build_sanitized
+[[ $stages == build ]] && exit 0
+[[ -x $build_dir/fuzz_follower_controller ]] || {
+  echo "sanitize: nothing built in $build_dir (run without --no-build)"; exit 1; }
 
 phase "sanitizers: gtests"
 rm -rf "$build_dir/test_results"

@@ -5,24 +5,27 @@
 #     the cross-check with the SciPy reference) run by ctest, two at a time (those that must run
 #     alone are RUN_SERIAL); then the multi-host cases of test/multihost/run_all.sh (network
 #     namespaces, root only, two at a time); all read back with catkin_test_results;
-#  2. the other two routes, catkin_make and catkin build, each in a fresh workspace; every
-#     workspace sourced and used as README says (scripts/check_workspace.sh);
-#  3. scripts/sanitize.sh: the core gtests under ASan + UBSan (clang, standalone CMake project) and
-#     a short libFuzzer run ($SANITIZE_FUZZ_SECONDS, default 25 s).
+#  2. beside those tests, at the lowest CPU priority (nice 19: a test that waits on the clock
+#     gets the processor when it wants it, the builds take what the tests leave): the other two
+#     routes, catkin_make and catkin build, each in a fresh workspace, and the sanitizer build;
+#     every workspace sourced and used as README says (scripts/check_workspace.sh);
+#  3. on a quiet machine again, scripts/sanitize.sh: the core gtests under ASan + UBSan (clang,
+#     standalone CMake project) and a short libFuzzer run ($SANITIZE_FUZZ_SECONDS, default 25 s).
 # The workspaces lie side by side in $TEST_BUILD_DIR (default: a new folder in $TMPDIR or /tmp),
 # each built by scripts/workspace.sh through one ccache: what the first compiled, the others find.
-# Each phase starts with a line "== phase NAME (at S s)", S the seconds since the first
+# Each phase starts with a line "== phase NAME (at S s)", S the seconds since the first; those of
+# step 2 read "== phase [beside] NAME (at S s)" and are printed when it ends
 # (experiments/ci_time/ci_phases.py reads them).
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 package=projection_collision_avoidance
 jobs=$(nproc)
 
-# phase NAME: "== phase NAME (at S s)", S from the first phase (PCA_PHASE_EPOCH, shared with
-# scripts/sanitize.sh).
+# phase NAME: "== phase [LANE] NAME (at S s)", S from the first phase (PCA_PHASE_EPOCH, shared
+# with scripts/sanitize.sh), [LANE] in a lane run beside the main one (PCA_PHASE_LANE).
 phase() {
   export PCA_PHASE_EPOCH=${PCA_PHASE_EPOCH:-$(date +%s)}
-  echo "== phase $1 (at $(($(date +%s) - PCA_PHASE_EPOCH)) s)"
+  echo "== phase ${PCA_PHASE_LANE:+[$PCA_PHASE_LANE] }$1 (at $(($(date +%s) - PCA_PHASE_EPOCH)) s)"
 }
 
 phase setup
@@ -40,7 +43,15 @@ else
 fi
 echo "test: workspaces in $tests_dir"
 passed_all=false
-trap '[[ $passed_all == true ]] && rm -rf "$tests_dir" || echo "test: workspaces kept in $tests_dir"' EXIT
+beside_pid=
+# On the way out: stop the builds beside the tests if they still run; remove the workspaces
+# when every test passed.
+finish() {
+  [[ -n $beside_pid ]] && kill -- "-$beside_pid" 2>/dev/null
+  if [[ $passed_all == true ]]; then rm -rf "$tests_dir"; else echo "test: workspaces kept in $tests_dir"; fi
+}
+trap finish EXIT
+trap 'exit 130' INT TERM
 ccache --zero-stats >/dev/null
 
 # check_workspace TOOL SPACE: README's route from there: source the workspace, then find, run and
@@ -65,6 +76,27 @@ phase "build: colcon workspace and the tests"
 build=$("$root/scripts/workspace.sh" colcon "$tests_dir" --tests)
 check_workspace colcon "$tests_dir/colcon/install"
 
+sanitize_dir=${SANITIZE_BUILD_DIR:-$root/build-sanitize}
+fuzz_seconds=${SANITIZE_FUZZ_SECONDS:-25}
+# beside_the_tests: the builds that need no quiet machine, one after another.
+beside_the_tests() {
+  export PCA_PHASE_LANE=beside
+  phase "build: catkin_make workspace"
+  "$root/scripts/workspace.sh" catkin_make "$tests_dir" >/dev/null
+  check_workspace catkin_make "$tests_dir/catkin_make/devel"
+  phase "build: catkin build workspace"
+  "$root/scripts/workspace.sh" catkin_build "$tests_dir" >/dev/null
+  check_workspace catkin_build "$tests_dir/catkin_build/devel"
+  SANITIZE_BUILD_DIR=$sanitize_dir "$root/scripts/sanitize.sh" --build-only
+  phase end
+}
+# A job of its own process group (set -m), so that finish() stops all of it; at nice 19.
+beside_log=$tests_dir/beside.log
+set -m
+(renice -n 19 -p "$BASHPID" >/dev/null || true; beside_the_tests) >"$beside_log" 2>&1 &
+beside_pid=$!
+set +m
+
 phase "tests: gtests, rostests, Python checks (ctest -j$jobs)"
 results=$build/test_results
 rm -rf "$results"
@@ -85,17 +117,18 @@ if [[ $results_ok != true || $failed -ne 0 || $passed -eq 0 ]]; then
   exit 1
 fi
 
-phase "build: catkin_make workspace"
-"$root/scripts/workspace.sh" catkin_make "$tests_dir" >/dev/null
-check_workspace catkin_make "$tests_dir/catkin_make/devel"
-phase "build: catkin build workspace"
-"$root/scripts/workspace.sh" catkin_build "$tests_dir" >/dev/null
-check_workspace catkin_build "$tests_dir/catkin_build/devel"
+phase "waiting for the builds beside the tests"
+beside_status=0
+wait "$beside_pid" || beside_status=$?
+beside_pid=
+cat "$beside_log"
+if [[ $beside_status -ne 0 ]]; then
+  echo "test: a build beside the tests failed (exit $beside_status; log above)"
+  exit 1
+fi
 
-sanitize_dir=${SANITIZE_BUILD_DIR:-$root/build-sanitize}
-fuzz_seconds=${SANITIZE_FUZZ_SECONDS:-25}
-SANITIZE_BUILD_DIR=$sanitize_dir "$root/scripts/sanitize.sh" --fuzz-seconds "$fuzz_seconds" || {
-  echo "$passed passed, $failed failed, $skipped skipped; sanitizer build or fuzzing FAILED"
+SANITIZE_BUILD_DIR=$sanitize_dir "$root/scripts/sanitize.sh" --no-build --fuzz-seconds "$fuzz_seconds" || {
+  echo "$passed passed, $failed failed, $skipped skipped; sanitizer tests or fuzzing FAILED"
   echo "test: scripts/sanitize.sh failed"
   exit 1
 }

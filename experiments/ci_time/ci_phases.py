@@ -32,7 +32,7 @@ import xml.etree.ElementTree as ET
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "common"))
 from doc_block import replace_block  # noqa: E402 (from experiments/common/)
 
-PHASE = re.compile(r"^== phase (?P<name>.+) \(at (?P<at>\d+) s\)\s*$")
+PHASE = re.compile(r"^== phase (?:\[(?P<lane>[^\]]+)\] )?(?P<name>.+) \(at (?P<at>\d+) s\)\s*$")
 STAMPED = re.compile(r"^(?P<epoch>\d{10}) (?P<text>.*)$")
 # Phase starts in the output of scripts/test.sh before it printed its own times.
 LEGACY_MARKERS = [
@@ -60,23 +60,31 @@ def read_lines(path):
 
 
 def read_phases(path):
-    """[(name, seconds)] in order: from test.sh's own phase lines where there are any, else from
-    the Unix times of a stamped log's LEGACY_MARKERS."""
-    phases, legacy = [], []
+    """[(name, seconds, lane)] in order: from test.sh's own phase lines where there are any, else
+    from the Unix times of a stamped log's LEGACY_MARKERS. Lane "" is the run's own; a phase of
+    another lane ran beside it (`== phase [LANE] NAME`), each lane ending with its own `end`."""
+    lanes, legacy = {}, []
     for line in read_lines(path):
         stamped = STAMPED.match(line)
         text = stamped["text"] if stamped else line
         m = PHASE.match(text)
         if m:
-            phases.append((m["name"], float(m["at"])))
+            lanes.setdefault(m["lane"] or "", []).append((m["name"], float(m["at"])))
         elif stamped:
             for marker, name in LEGACY_MARKERS:
                 if marker.match(text):
                     legacy.append((name, float(stamped["epoch"])))
-    starts = phases or legacy
-    if not starts or starts[-1][0] != "end":
-        sys.exit(f"{path}: no end of the run found (an unfinished run?)")
-    return [(name, nxt - at) for (name, at), (_, nxt) in zip(starts, starts[1:])]
+    if not lanes and legacy:
+        lanes[""] = legacy
+    phases = []
+    for lane, starts in lanes.items():
+        if not starts or starts[-1][0] != "end":
+            sys.exit(f"{path}: no end of {'the run' if not lane else lane} found (an unfinished "
+                     "run?)")
+        phases += [(name, nxt - at, lane) for (name, at), (_, nxt) in zip(starts, starts[1:])]
+    if "" not in lanes:
+        sys.exit(f"{path}: no phase of the run itself")
+    return phases
 
 
 def group_of(name):
@@ -121,16 +129,26 @@ def minutes(seconds):
 
 
 def phases_table(before, after):
+    """The phases of both runs, one row per name; a phase of another lane is marked so, and the
+    total is the run's own lane, start to end."""
     names = []
-    for name, _ in before + after:
+    for name, _, _ in before + after:
         if name not in names:
             names.append(name)
-    b, a = dict(before), dict(after)
+
+    def cell(phases, name):
+        found = [(seconds, lane) for n, seconds, lane in phases if n == name]
+        if not found:
+            return "—"
+        seconds, lane = found[0]
+        return minutes(seconds) + (f", {lane} the tests" if lane else "")
+
+    def total(phases):
+        return minutes(sum(seconds for _, seconds, lane in phases if not lane))
+
     rows = ["| phase | before (min) | after (min) |", "|---|---|---|"]
-    for name in names:
-        rows.append(f"| {name} | {minutes(b[name]) if name in b else '—'} | "
-                    f"{minutes(a[name]) if name in a else '—'} |")
-    rows.append(f"| **total** | **{minutes(sum(b.values()))}** | **{minutes(sum(a.values()))}** |")
+    rows += [f"| {name} | {cell(before, name)} | {cell(after, name)} |" for name in names]
+    rows.append(f"| **total** | **{total(before)}** | **{total(after)}** |")
     return "\n".join(rows)
 
 
@@ -165,6 +183,8 @@ def report(args):
     before, after = read_phases(args.before), read_phases(args.after)
     text = "\n\n".join([
         phases_table(before, after),
+        "A phase marked \"beside the tests\" ran at the same time as the tests, at nice 19 "
+        "(scripts/test.sh, step 2); a total is the run's own phases, start to end.",
         "Each group's tests, their own times summed (tests that run two at a time overlap, so a "
         "sum can exceed its phase):",
         tests_table(test_times(args.before, args.before_results),
@@ -192,8 +212,8 @@ def main():
     r.add_argument("--update")
     args = parser.parse_args()
     if args.command == "phases":
-        for name, seconds in read_phases(args.log):
-            print(f"{seconds:8.0f} s  {name}")
+        for name, seconds, lane in read_phases(args.log):
+            print(f"{seconds:8.0f} s  {name}" + (f"  [{lane} the tests]" if lane else ""))
     elif args.command == "tests":
         times = test_times(args.log, args.results)
         if args.csv:
