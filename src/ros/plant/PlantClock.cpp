@@ -13,6 +13,8 @@ namespace {
 constexpr double kTickTolerance = 1e-6;
 /// Wall seconds of ticks that one wall-timer callback may catch up.
 constexpr double kMaxCatchUp = 0.05;
+/// Steady seconds between two reports of dropped backlog.
+constexpr double kDropReportPeriod = 5.0;
 
 }  // namespace
 
@@ -271,21 +273,37 @@ long PlantClock::dueAt(const ros::Time& now) const {
 
 long PlantClock::dropWallBacklog(long due, const ros::Time& now) {
   const long max_catch_up = std::max(1L, std::lround(kMaxCatchUp * options_.rate));
-  if (due - next_tick_ < max_catch_up) {
-    return due;
+  if (due - next_tick_ >= max_catch_up) {
+    // The ticks from next_tick_ on are stamped from now: no stamp lags the wall clock by more
+    // than kMaxCatchUp, so neither the samples nor the judgement of the commands (stamped by
+    // their senders on the wall clock) fall behind; scenario time runs slower instead.
+    const double behind = static_cast<double>(due - next_tick_ + 1) / options_.rate;
+    dropped_seconds_ += behind;
+    unreported_seconds_ += behind;
+    origin_ = now - ros::Duration(static_cast<double>(next_tick_) / options_.rate);
+    due = next_tick_;
   }
-  // The ticks from next_tick_ on are stamped from now: no stamp lags the wall clock by more than
-  // kMaxCatchUp, so neither the samples nor the judgement of the commands (stamped by their
-  // senders on the wall clock) fall behind; scenario time runs slower instead.
-  const double behind = static_cast<double>(due - next_tick_ + 1) / options_.rate;
-  dropped_seconds_ += behind;
-  origin_ = now - ros::Duration(static_cast<double>(next_tick_) / options_.rate);
-  ROS_WARN_STREAM_THROTTLE(5.0, name_ << ": " << behind
-                                      << " s behind the wall clock (the plant was stalled or "
-                                         "cannot keep up with ~rate): those ticks are dropped, "
-                                         "scenario time runs slower than wall time ("
-                                      << dropped_seconds_ << " s dropped in all)");
-  return next_tick_;
+  reportDrops();
+  return due;
+}
+
+void PlantClock::reportDrops() {
+  if (unreported_seconds_ <= 0.0) {
+    return;
+  }
+  // At most one report per kDropReportPeriod, and none withheld for longer: what a period
+  // holds back (a stall just after a small drop was reported) is reported when it ends.
+  const ros::SteadyTime now = ros::SteadyTime::now();
+  if (!last_drop_report_.isZero() && (now - last_drop_report_).toSec() < kDropReportPeriod) {
+    return;
+  }
+  ROS_WARN_STREAM(name_ << ": " << unreported_seconds_
+                        << " s behind the wall clock since the last report (the plant was "
+                           "stalled or cannot keep up with ~rate): those ticks are dropped, "
+                           "scenario time runs slower than wall time ("
+                        << dropped_seconds_ << " s dropped in all)");
+  unreported_seconds_ = 0.0;
+  last_drop_report_ = now;
 }
 
 }  // namespace projection_collision_avoidance

@@ -26,8 +26,8 @@ namespace projection_collision_avoidance {
 /// it waits for it to reach the next tick again. On wall time those ticks run on a thread of its
 /// own ("plant tick") sleeping to monotonic deadlines, one wake-up per tick. On wall time a backlog
 /// of more than 50 ms (a stall, or more agents than the plant can integrate at ~rate) is dropped
-/// and reported, the ticks after it stamped from the wall clock: stamps stay within 50 ms of the
-/// senders' clocks.
+/// and reported (at most every 5 s, each drop within 5 s), the ticks after it stamped from the
+/// wall clock: stamps stay within 50 ms of the senders' clocks.
 ///
 /// Holding simulated time (publish_clock only): with ~wait_for_followers it stays at its start
 /// until every follower listens and every topic of ~wait_for_subscribers has a subscriber (or
@@ -90,6 +90,9 @@ class PlantClock {
   long dropWallBacklog(long due, const ros::Time& now);
   /// Wall time: dropWallBacklog() for the tick due now (nothing before the first tick).
   void dropWallBacklogNow();
+  /// Wall time: warns of the backlog dropped since the last warning, at most every 5 s (steady
+  /// clock); a drop withheld by that limit is reported once it has passed.
+  void reportDrops();
   /// The last tick due at ROS time @p now by the origin.
   long dueAt(const ros::Time& now) const;
   /// Runs the ticks from next_tick_ through @p due while the plant runs (and, in lockstep, the
@@ -119,6 +122,8 @@ class PlantClock {
   ros::WallTime hold_start_;
   std::uint64_t lockstep_timeouts_ = 0;  ///< ticks that ran without every command
   double dropped_seconds_ = 0.0;         ///< wall time: backlog dropped so far (s)
+  double unreported_seconds_ = 0.0;      ///< wall time: dropped since the last report (s)
+  ros::SteadyTime last_drop_report_;     ///< zero before the first report
   double factor_ = 0.0;  ///< publish_clock: the real-time factor the schedule runs at
   ros::WallTime rate_check_wall_;
   long rate_check_tick_ = 0;
