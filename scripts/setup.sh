@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages of scripts/debian-packages.txt that are missing, and nothing else.
-# Usage: scripts/setup.sh [--list]
-#   --list  print the packages and exit
+# Usage: scripts/setup.sh [--list | PACKAGE...]
+#   --list      print the packages and exit
+#   PACKAGE...  only these (each one of the list; scripts/test.sh installs what its sanitizer
+#               build needs first, to build beside the rest of the installation)
 # Runs apt-get as root, through sudo when not root.
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -12,9 +14,15 @@ mapfile -t packages < <(sed -e 's/#.*//' -e '/^[[:space:]]*$/d' "$root/scripts/d
 if [[ "${1:-}" == "--list" ]]; then
   printf '%s\n' "${packages[@]}"
   exit 0
-elif [[ $# -gt 0 ]]; then
-  echo "usage: scripts/setup.sh [--list]" >&2
+elif [[ "${1:-}" == -* ]]; then
+  echo "usage: scripts/setup.sh [--list | PACKAGE...]" >&2
   exit 2
+elif [[ $# -gt 0 ]]; then
+  for package in "$@"; do
+    printf '%s\n' "${packages[@]}" | grep -qxF -- "$package" || {
+      echo "setup: $package is not in scripts/debian-packages.txt" >&2; exit 2; }
+  done
+  packages=("$@")
 fi
 
 missing=()

@@ -5,10 +5,12 @@
 #     the cross-check with the SciPy reference) run by ctest, two at a time (those that must run
 #     alone are RUN_SERIAL); then the multi-host cases of test/multihost/run_all.sh (network
 #     namespaces, root only, two at a time); all read back with catkin_test_results;
-#  2. beside those tests, at the lowest CPU priority (nice 19: a test that waits on the clock
-#     gets the processor when it wants it, the builds take what the tests leave): the other two
-#     routes, catkin_make and catkin build, each in a fresh workspace, and the sanitizer build;
-#     every workspace sourced and used as README says (scripts/check_workspace.sh);
+#  2. beside all that, at the lowest CPU priority (nice 19: the installation, the colcon build
+#     and a test that waits on the clock get the processor when they want it; these builds take
+#     what is left): the sanitizer build, started once its packages are installed (the rest of
+#     the installation keeps dpkg busy on one core), then, once the colcon build is done, the
+#     other two routes, catkin_make and catkin build, each in a fresh workspace; every workspace
+#     sourced and used as README says (scripts/check_workspace.sh);
 #  3. on a quiet machine again, scripts/sanitize.sh: the core gtests under ASan + UBSan (clang,
 #     standalone CMake project) and a short libFuzzer run ($SANITIZE_FUZZ_SECONDS, default 25 s).
 # The workspaces lie side by side in $TEST_BUILD_DIR (default: a new folder in $TMPDIR or /tmp),
@@ -27,9 +29,6 @@ phase() {
   export PCA_PHASE_EPOCH=${PCA_PHASE_EPOCH:-$(date +%s)}
   echo "== phase ${PCA_PHASE_LANE:+[$PCA_PHASE_LANE] }$1 (at $(($(date +%s) - PCA_PHASE_EPOCH)) s)"
 }
-
-phase setup
-"$root/scripts/setup.sh"
 
 # The workspaces, outside the package (a workspace inside it, linked back to it from its src/,
 # would let roslaunch and rospack find the package again at every level). Removed when every
@@ -52,7 +51,6 @@ finish() {
 }
 trap finish EXIT
 trap 'exit 130' INT TERM
-ccache --zero-stats >/dev/null
 
 # check_workspace TOOL SPACE: README's route from there: source the workspace, then find, run and
 # launch the package.
@@ -72,30 +70,46 @@ ccache_hits() {
     END { printf "%d of %d compilations from the cache", hits, hits + misses }'
 }
 
-phase "build: colcon workspace and the tests"
-build=$("$root/scripts/workspace.sh" colcon "$tests_dir" --tests)
-check_workspace colcon "$tests_dir/colcon/install"
-
 sanitize_dir=${SANITIZE_BUILD_DIR:-$root/build-sanitize}
 fuzz_seconds=${SANITIZE_FUZZ_SECONDS:-25}
+colcon_built=$tests_dir/colcon.built
 # beside_the_tests: the builds that need no quiet machine, one after another.
 beside_the_tests() {
   export PCA_PHASE_LANE=beside
+  # A cache of its own (clang's objects are no use to the workspaces; and test.sh counts the
+  # workspaces' hits).
+  CCACHE_DIR=$(ccache -k cache_dir)-sanitize SANITIZE_BUILD_DIR=$sanitize_dir \
+    "$root/scripts/sanitize.sh" --build-only
+  # The other two routes find in the cache what the colcon build compiled.
+  phase "waiting for the colcon build"
+  while [[ ! -e $colcon_built ]]; do sleep 1; done
   phase "build: catkin_make workspace"
   "$root/scripts/workspace.sh" catkin_make "$tests_dir" >/dev/null
   check_workspace catkin_make "$tests_dir/catkin_make/devel"
   phase "build: catkin build workspace"
   "$root/scripts/workspace.sh" catkin_build "$tests_dir" >/dev/null
   check_workspace catkin_build "$tests_dir/catkin_build/devel"
-  SANITIZE_BUILD_DIR=$sanitize_dir "$root/scripts/sanitize.sh" --build-only
   phase end
 }
+
+# What the sanitizer build needs first, then the rest beside it.
+phase "setup: what the sanitizer build needs"
+"$root/scripts/setup.sh" build-essential make cmake pkg-config ccache libeigen3-dev \
+  libyaml-cpp-dev libyaml-dev googletest libgtest-dev clang libclang-rt-14-dev llvm python3
 # A job of its own process group (set -m), so that finish() stops all of it; at nice 19.
 beside_log=$tests_dir/beside.log
 set -m
 (renice -n 19 -p "$BASHPID" >/dev/null || true; beside_the_tests) >"$beside_log" 2>&1 &
 beside_pid=$!
 set +m
+phase "setup: the rest (the sanitizer build beside it)"
+"$root/scripts/setup.sh"
+
+phase "build: colcon workspace and the tests"
+ccache --zero-stats >/dev/null
+build=$("$root/scripts/workspace.sh" colcon "$tests_dir" --tests)
+check_workspace colcon "$tests_dir/colcon/install"
+touch "$colcon_built"
 
 phase "tests: gtests, rostests, Python checks (ctest -j$jobs)"
 results=$build/test_results
