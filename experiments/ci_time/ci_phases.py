@@ -141,7 +141,7 @@ def phases_table(before, after):
         if not found:
             return "—"
         seconds, lane = found[0]
-        return minutes(seconds) + (f", {lane} the tests" if lane else "")
+        return minutes(seconds) + (f", {lane} (nice 19)" if lane else "")
 
     def total(phases):
         return minutes(sum(seconds for _, seconds, lane in phases if not lane))
@@ -179,12 +179,32 @@ def test_times(log, results):
     return tests_from_results(results)
 
 
+COUNTS = re.compile(r"(?P<passed>\d+) passed, (?P<failed>\d+) failed, \d+ skipped "
+                    r"\(and under ASan \+ UBSan: (?P<sanitized>\d+) passed")
+
+
+def counts(path):
+    """The run's last line of counts: "P passed (+ S under ASan + UBSan), F failed"."""
+    found = None
+    for line in read_lines(path):
+        m = COUNTS.search(line)
+        if m:
+            found = m
+    if not found:
+        return "no count"
+    return (f"{found['passed']} passed + {found['sanitized']} under ASan + UBSan, "
+            f"{found['failed']} failed")
+
+
 def report(args):
     before, after = read_phases(args.before), read_phases(args.after)
     text = "\n\n".join([
         phases_table(before, after),
-        "A phase marked \"beside the tests\" ran at the same time as the tests, at nice 19 "
-        "(scripts/test.sh, step 2); a total is the run's own phases, start to end.",
+        f"Test cases (the run's last line): before {counts(args.before)}; after "
+        f"{counts(args.after)}.",
+        "A phase marked \"beside\" ran in a job of its own at nice 19, at the same time as the "
+        "run's own phases (scripts/test.sh, step 2); a total is the run's own phases, start to "
+        "end.",
         "Each group's tests, their own times summed (tests that run two at a time overlap, so a "
         "sum can exceed its phase):",
         tests_table(test_times(args.before, args.before_results),
@@ -213,7 +233,7 @@ def main():
     args = parser.parse_args()
     if args.command == "phases":
         for name, seconds, lane in read_phases(args.log):
-            print(f"{seconds:8.0f} s  {name}" + (f"  [{lane} the tests]" if lane else ""))
+            print(f"{seconds:8.0f} s  {name}" + (f"  [{lane}]" if lane else ""))
     elif args.command == "tests":
         times = test_times(args.log, args.results)
         if args.csv:
