@@ -22,7 +22,7 @@ while [[ $# -gt 0 ]]; do
     --fuzz-seconds) fuzz_seconds=${2:?--fuzz-seconds needs a value}; shift 2 ;;
     --fuzz-seconds=*) fuzz_seconds=${1#*=}; shift ;;
     --build-only) stages=build; shift ;;
-    --no-build) stages=test; shift ;;
+    --no-build) stages=tests; shift ;;
     -h|--help) sed -n '2,15p' "$0"; exit 0 ;;
     *) echo "sanitize: unknown argument $1" >&2; exit 2 ;;
   esac
@@ -60,7 +60,7 @@ build_sanitized() {
   echo "built in $((SECONDS - start)) s"
 }
 
-[[ $stages == test ]] || build_sanitized
+[[ $stages == tests ]] || build_sanitized
 [[ $stages == build ]] && exit 0
 [[ -x $build_dir/fuzz_follower_controller ]] || {
   echo "sanitize: nothing built in $build_dir (run without --no-build)"; exit 1; }

@@ -147,7 +147,7 @@ SANITIZE_BUILD_DIR=$sanitize_dir "$root/scripts/sanitize.sh" --no-build --fuzz-s
   exit 1
 }
 # The same count over the sanitizer build's gtest XML.
-read -r san_passed san_failed san_skipped < <(/usr/bin/python3 "$root/test/tools/count_test_results.py" "$sanitize_dir/test_results")
+read -r san_passed san_failed _ < <(/usr/bin/python3 "$root/test/tools/count_test_results.py" "$sanitize_dir/test_results")
 phase end
 passed_all=true
 echo "$passed passed, $failed failed, $skipped skipped" \
