@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Runs the paper's Run 2 through the ROS graph (test/ros/faults.test: 100 Hz, simulated time at
+# Runs the paper's Run 2 through the ROS graph (test/rostest/faults.test: 100 Hz, simulated time at
 # 5x real time, acceleration limit 6 m/s^2) at a range of fault levels, and writes what held as a
 # Markdown table to doc/fault_table.md (and stdout). Rows marked "tested" are the ones
 # CMakeLists.txt registers as rostests; the others go beyond them.

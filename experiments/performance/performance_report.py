@@ -255,9 +255,9 @@ def ros_rows(ros):
 def ros_section(ros):
     medians = ros_rows(ros)
     lines = ["## ROS pipeline at 1 kHz", "",
-             "`bash experiments/ros_latency/run.sh` (`test/performance/latency.launch`): a probe "
+             "`bash experiments/ros_latency/run.sh` (`experiments/probes/latency.launch`): a probe "
              "publishes relative measurements at 1 kHz on real time; a bare roscpp relay "
-             "(`test/performance/measurement_relay.cpp`), a follower triggered by each "
+             "(`experiments/probes/measurement_relay.cpp`), a follower triggered by each "
              "measurement (`~trigger: measurement`) and a follower on its 1 kHz timer "
              "(`~trigger: timer`) all subscribe to it in the same run; in the SCHED_FIFO setting all "
              "four run under `chrt -f 50`; in the control-thread setting both followers run their "

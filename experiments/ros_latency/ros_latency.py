@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Latency of the follower pipeline (run by experiments/ros_latency/run.sh, which sets up ROS).
 
-`run` launches test/performance/latency.launch RUNS times per setting, each on its own master
+`run` launches experiments/probes/latency.launch RUNS times per setting, each on its own master
 (roslaunch -p PORT), and keeps the probe's JSON of each run; the settings are the machine as it
 is ("as is") and with one nice-19 busy loop per core ("keep-awake": on this Firecracker VM an
 idle core halts and wakes late, which delays timers and message deliveries), with --realtime

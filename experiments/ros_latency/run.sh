@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Latency of the follower pipeline in real time: test/performance/latency.launch, RUNS times per
+# Latency of the follower pipeline in real time: experiments/probes/latency.launch, RUNS times per
 # setting, each on its own master. latency_probe publishes measurements at 1 kHz for DURATION s
 # to a bare roscpp relay (measurement_relay), a follower with ~trigger measurement and one with
 # ~trigger timer (paper_run2.yaml at 1000 Hz), and measures publication -> relay output and

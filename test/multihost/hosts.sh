@@ -9,8 +9,8 @@
 #
 # Usage: test/multihost/hosts.sh BUILD_DIR pair|formation [--followers N] [--clocks LIST]
 #          [--log DIR] [launch args for every host...]
-#   pair       Run 2 (test/ros/paper_run2.test): the follower on its own host
-#   formation  test/ros/formation.test with N followers (default 3) in a chain, each on its host
+#   pair       Run 2 (test/rostest/paper_run2.test): the follower on its own host
+#   formation  test/rostest/formation.test with N followers (default 3) in a chain, each on its host
 #              (launch/fleet_follower.launch there)
 #   --log DIR  keep the hosts' logs there (default: a temporary directory, removed on exit)
 # e.g. test/multihost/hosts.sh build pair --clocks +2s sim_time:=false \

@@ -21,7 +21,7 @@
 #include <sched.h>
 #include <sys/mman.h>
 
-#include "projection_collision_avoidance/rt/RealtimeLoop.hpp"
+#include "projection_collision_avoidance/rt/PeriodicThread.hpp"
 
 namespace projection_collision_avoidance {
 namespace {

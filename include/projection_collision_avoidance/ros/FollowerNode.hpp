@@ -61,7 +61,7 @@ struct Scenario;
 /// ros::Timer on a callback queue served by a spinner thread of its own; on wall time the
 /// SharedTicker thread of its control rate (no real-time priority), which runs the ticks of every
 /// follower of the process at that rate in turn, each publishing on that thread.
-/// "thread": a PeriodicThread (RealtimeLoop.hpp) that sleeps with clock_nanosleep to absolute
+/// "thread": a PeriodicThread (rt/PeriodicThread.hpp) that sleeps with clock_nanosleep to absolute
 /// CLOCK_MONOTONIC deadlines k / control_rate from its start and runs the same tick at each,
 /// stamped with ros::Time::now(); refused under /use_sim_time. Its missed periods ("timer"
 /// trigger) are the deadlines it skipped because a tick overran or woke late (it re-aligns to the

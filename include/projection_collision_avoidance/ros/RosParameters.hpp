@@ -12,7 +12,7 @@
 #include <xmlrpcpp/XmlRpcValue.h>
 #include <yaml-cpp/yaml.h>
 
-#include "projection_collision_avoidance/node/StampCorrection.hpp"
+#include "projection_collision_avoidance/cycle/StampCorrection.hpp"
 #include "projection_collision_avoidance/sim/Scenario.hpp"
 
 namespace projection_collision_avoidance {

@@ -11,7 +11,7 @@
 #include <memory>
 #include <string>
 
-#include "projection_collision_avoidance/rt/RealtimeLoop.hpp"
+#include "projection_collision_avoidance/rt/PeriodicThread.hpp"
 
 namespace projection_collision_avoidance {
 

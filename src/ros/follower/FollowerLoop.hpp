@@ -7,9 +7,9 @@
 #include <ros/callback_queue.h>
 #include <ros/ros.h>
 
-#include "projection_collision_avoidance/node/FollowerCycle.hpp"
+#include "projection_collision_avoidance/cycle/FollowerCycle.hpp"
 #include "projection_collision_avoidance/ros/InputAdmission.hpp"
-#include "projection_collision_avoidance/rt/RealtimeLoop.hpp"
+#include "projection_collision_avoidance/rt/PeriodicThread.hpp"
 #include "projection_collision_avoidance/rt/SharedTicker.hpp"
 
 #include "follower/FollowerOptions.hpp"

@@ -5,7 +5,7 @@
 
 #include "projection_collision_avoidance/core/ControllerParameters.hpp"
 #include "projection_collision_avoidance/core/Formation.hpp"
-#include "projection_collision_avoidance/node/StampCorrection.hpp"
+#include "projection_collision_avoidance/cycle/StampCorrection.hpp"
 #include "projection_collision_avoidance/ros/RosParameters.hpp"
 #include "projection_collision_avoidance/sim/Scenario.hpp"
 

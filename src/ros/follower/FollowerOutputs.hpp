@@ -12,7 +12,7 @@
 #include <ros/ros.h>
 
 #include "projection_collision_avoidance/core/Formation.hpp"
-#include "projection_collision_avoidance/node/FollowerCycle.hpp"
+#include "projection_collision_avoidance/cycle/FollowerCycle.hpp"
 #include "projection_collision_avoidance/ros/CountedPublisher.hpp"
 #include "projection_collision_avoidance/rt/Handoff.hpp"
 

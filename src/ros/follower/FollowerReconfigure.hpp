@@ -10,7 +10,7 @@
 
 #include "projection_collision_avoidance/FollowerConfig.h"
 #include "projection_collision_avoidance/core/ControllerParameters.hpp"
-#include "projection_collision_avoidance/node/FollowerCycle.hpp"
+#include "projection_collision_avoidance/cycle/FollowerCycle.hpp"
 
 #include "follower/FollowerOutputs.hpp"
 

@@ -4,7 +4,7 @@
 
 #include "projection_collision_avoidance/FollowerStatus.h"
 #include "projection_collision_avoidance/core/Formation.hpp"
-#include "projection_collision_avoidance/node/FollowerCycle.hpp"
+#include "projection_collision_avoidance/cycle/FollowerCycle.hpp"
 
 #include "follower/FollowerInputs.hpp"
 

@@ -9,7 +9,7 @@
 #include <ros/ros.h>
 
 #include "projection_collision_avoidance/ros/InputAdmission.hpp"
-#include "projection_collision_avoidance/rt/RealtimeLoop.hpp"
+#include "projection_collision_avoidance/rt/PeriodicThread.hpp"
 
 #include "plant/PlantOptions.hpp"
 

@@ -18,7 +18,6 @@
 #include "projection_collision_avoidance/core/Formation.hpp"
 #include "projection_collision_avoidance/core/ParameterError.hpp"
 #include "projection_collision_avoidance/ros/MessageConversions.hpp"
-#include "projection_collision_avoidance/ros/PlantNode.hpp"
 
 namespace projection_collision_avoidance {
 namespace {
@@ -450,10 +449,5 @@ void PlantWorld::stop(const std::string& why) {
       ros::WallDuration(kShutdownDelay), [](const ros::WallTimerEvent&) { ros::requestShutdown(); },
       true);
 }
-
-PlantNode::PlantNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
-    : world_(std::make_unique<PlantWorld>(nh, private_nh)) {}
-
-PlantNode::~PlantNode() = default;
 
 }  // namespace projection_collision_avoidance
