@@ -2,8 +2,7 @@
 
 #include "projection_collision_avoidance/core/ParameterError.hpp"
 #include "projection_collision_avoidance/core/TypeDefs.hpp"
-
-#include "ValidationChecks.hpp"
+#include "projection_collision_avoidance/core/ValidationChecks.hpp"
 
 namespace projection_collision_avoidance {
 

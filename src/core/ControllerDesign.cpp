@@ -14,8 +14,7 @@
 #include "projection_collision_avoidance/core/PaperLaws.hpp"
 #include "projection_collision_avoidance/core/ParameterError.hpp"
 #include "projection_collision_avoidance/core/PlatoonLaws.hpp"
-
-#include "ValidationChecks.hpp"
+#include "projection_collision_avoidance/core/ValidationChecks.hpp"
 
 namespace projection_collision_avoidance {
 namespace {
@@ -258,11 +257,8 @@ ControllerDesign ControllerDesign::create(const ControllerParameters& parameters
 
 Eigen::VectorXd ControllerDesign::leaderAcceleration(const Eigen::VectorXd& leader_input,
                                                      const Eigen::VectorXd& disturbance) const {
-  if (parameters.leader_disturbance_shared && disturbance.size() > 0) {
-    return projection_collision_avoidance::leaderAcceleration(leader_input, input_pseudoinverse,
-                                                              disturbance);
-  }
-  return leader_input;
+  return sharedLeaderAcceleration(parameters.leader_disturbance_shared, leader_input,
+                                  input_pseudoinverse, disturbance);
 }
 
 }  // namespace projection_collision_avoidance

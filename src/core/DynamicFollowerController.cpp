@@ -1,6 +1,8 @@
 #include "projection_collision_avoidance/core/DynamicFollowerController.hpp"
 
+#include <optional>
 #include <stdexcept>
+#include <string>
 #include <type_traits>
 #include <utility>
 
@@ -13,6 +15,16 @@ namespace {
 template <typename Vector>
 Vector as(const Eigen::Ref<const Eigen::VectorXd>& x) {
   return Vector(x);
+}
+
+/// Refuses an input of another size than the model's (std::invalid_argument naming it).
+void checkSize(const std::optional<Eigen::Ref<const Eigen::VectorXd>>& x, int size,
+               const char* name) {
+  if (x && x->size() != size) {
+    throw std::invalid_argument(std::string("DynamicFollowerController::step: ") + name + " has " +
+                                std::to_string(x->size()) + " entries, the model " +
+                                std::to_string(size));
+  }
 }
 
 }  // namespace
@@ -43,84 +55,26 @@ const DynamicFollowerStatus& DynamicFollowerController::visitStep(const Call& ca
   return status_;
 }
 
-// Each step converts its arguments to the controller's vector types (fixed-size or bounded: no
+// The step converts its inputs to the controller's vector types (fixed-size or bounded: no
 // allocation); visitStep() copies the controller's status into the run-time-sized one.
-const DynamicFollowerStatus& DynamicFollowerController::step(
-    const Eigen::Ref<const Eigen::VectorXd>& y) {
+const DynamicFollowerStatus& DynamicFollowerController::step(const DynamicStepInputs& inputs) {
+  checkSize(inputs.measurement, outputDimension(), "measurement");
+  checkSize(inputs.leader_input, inputDimension(), "leader_input");
+  checkSize(inputs.own_state, stateDimension(), "own_state");
   return visitStep([&](auto& controller) -> const auto& {
     using C = std::decay_t<decltype(controller)>;
-    return controller.step(as<typename C::OutputVector>(y));
+    StepInputs<typename C::Dimensions> converted;
+    if (inputs.measurement) {
+      converted.measurement = as<typename C::OutputVector>(*inputs.measurement);
+    }
+    if (inputs.leader_input) {
+      converted.leader_input = as<typename C::InputVector>(*inputs.leader_input);
+    }
+    if (inputs.own_state) {
+      converted.own_state = as<typename C::StateVector>(*inputs.own_state);
+    }
+    return controller.step(converted);
   });
-}
-
-const DynamicFollowerStatus& DynamicFollowerController::step(
-    const Eigen::Ref<const Eigen::VectorXd>& y,
-    const Eigen::Ref<const Eigen::VectorXd>& leader_input) {
-  return visitStep([&](auto& controller) -> const auto& {
-    using C = std::decay_t<decltype(controller)>;
-    return controller.step(as<typename C::OutputVector>(y),
-                           as<typename C::InputVector>(leader_input));
-  });
-}
-
-const DynamicFollowerStatus& DynamicFollowerController::stepWithOwnState(
-    const Eigen::Ref<const Eigen::VectorXd>& y,
-    const Eigen::Ref<const Eigen::VectorXd>& own_state) {
-  return visitStep([&](auto& controller) -> const auto& {
-    using C = std::decay_t<decltype(controller)>;
-    return controller.stepWithOwnState(as<typename C::OutputVector>(y),
-                                       as<typename C::StateVector>(own_state));
-  });
-}
-
-const DynamicFollowerStatus& DynamicFollowerController::stepWithOwnState(
-    const Eigen::Ref<const Eigen::VectorXd>& y, const Eigen::Ref<const Eigen::VectorXd>& own_state,
-    const Eigen::Ref<const Eigen::VectorXd>& leader_input) {
-  return visitStep([&](auto& controller) -> const auto& {
-    using C = std::decay_t<decltype(controller)>;
-    return controller.stepWithOwnState(as<typename C::OutputVector>(y),
-                                       as<typename C::StateVector>(own_state),
-                                       as<typename C::InputVector>(leader_input));
-  });
-}
-
-const DynamicFollowerStatus& DynamicFollowerController::stepFallback() {
-  return visitStep([&](auto& controller) -> const auto& { return controller.stepFallback(); });
-}
-
-const DynamicFollowerStatus& DynamicFollowerController::stepFallback(
-    const Eigen::Ref<const Eigen::VectorXd>& leader_input) {
-  return visitStep([&](auto& controller) -> const auto& {
-    using C = std::decay_t<decltype(controller)>;
-    return controller.stepFallback(as<typename C::InputVector>(leader_input));
-  });
-}
-
-void DynamicFollowerController::setDesign(const ControllerDesign& design) {
-  const AgentModel& now = this->design().parameters.model;
-  const AgentModel& next = design.parameters.model;
-  if (now.stateDimension() != next.stateDimension() ||
-      now.inputDimension() != next.inputDimension() ||
-      now.outputDimension() != next.outputDimension()) {
-    throw std::invalid_argument("DynamicFollowerController::setDesign: model sizes changed");
-  }
-  const Eigen::VectorXd kept = estimate();
-  const Eigen::VectorXd kept_command = previousCommand();
-  const bool initialized =
-      std::visit([](const auto& controller) { return controller.initialized(); }, controller_);
-  Variant replacement = makeController(design);
-  std::visit(
-      [&](auto& controller) {
-        using Controller = std::decay_t<decltype(controller)>;
-        const typename Controller::InputVector command = kept_command;
-        controller.setPreviousCommand(command);
-        if (initialized) {
-          const typename Controller::StateVector estimate = kept;
-          controller.resetEstimate(estimate);
-        }
-      },
-      replacement);
-  controller_ = std::move(replacement);
 }
 
 void DynamicFollowerController::adoptStateOf(const DynamicFollowerController& other) {
@@ -132,11 +86,7 @@ void DynamicFollowerController::adoptStateOf(const DynamicFollowerController& ot
   std::visit(
       [&](auto& controller) {
         using Controller = std::decay_t<decltype(controller)>;
-        const Controller& source = std::get<Controller>(other.controller_);
-        controller.setPreviousCommand(source.previousCommand());
-        if (source.initialized()) {
-          controller.resetEstimate(source.estimate());
-        }
+        controller.adoptStateOf(std::get<Controller>(other.controller_));
       },
       controller_);
 }

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstddef>
 
+#include "projection_collision_avoidance/core/FollowerConfiguration.hpp"
 #include "projection_collision_avoidance/core/ParameterError.hpp"
 
 namespace projection_collision_avoidance {
@@ -41,6 +42,28 @@ void FormationSpec::validate(const AgentModel& model) const {
   }
 }
 
+FormationMember formationSlot(const FormationSpec& spec, const Eigen::VectorXd& separation,
+                              int index) {
+  FormationMember member;
+  member.index = index;
+  member.name = spec.configured ? "follower_" + std::to_string(index) : "follower";
+  const bool chain = spec.topology == FormationTopology::kChain;
+  if (spec.shape == FormationShape::kLine) {
+    member.target = chain ? index - 1 : 0;
+    member.separation =
+        chain ? separation : Eigen::VectorXd(static_cast<double>(index) * separation);
+  } else {
+    const int rank = (index + 1) / 2;
+    const double angle = index % 2 == 1 ? spec.half_angle : -spec.half_angle;
+    const Eigen::VectorXd arm = turnedInPlane(separation, angle);
+    member.target = chain ? (index > 2 ? index - 2 : 0) : 0;
+    member.separation = chain ? arm : Eigen::VectorXd(static_cast<double>(rank) * arm);
+  }
+  member.target_name = member.target == 0 ? std::string("leader")
+                                          : formationSlot(spec, separation, member.target).name;
+  return member;
+}
+
 std::vector<FormationMember> layoutFormation(const FormationSpec& spec,
                                              const Eigen::VectorXd& separation,
                                              const Eigen::VectorXd& leader_initial_state,
@@ -49,29 +72,22 @@ std::vector<FormationMember> layoutFormation(const FormationSpec& spec,
   std::vector<FormationMember> members;
   members.reserve(static_cast<std::size_t>(spec.followers));
   for (int i = 1; i <= spec.followers; ++i) {
-    FormationMember member;
-    member.index = i;
-    member.name = spec.configured ? "follower_" + std::to_string(i) : "follower";
-    const bool chain = spec.topology == FormationTopology::kChain;
-    if (spec.shape == FormationShape::kLine) {
-      member.target = chain ? i - 1 : 0;
-      member.separation = chain ? separation : Eigen::VectorXd(static_cast<double>(i) * separation);
-    } else {
-      const int rank = (i + 1) / 2;
-      const double angle = i % 2 == 1 ? spec.half_angle : -spec.half_angle;
-      const Eigen::VectorXd arm = turnedInPlane(separation, angle);
-      member.target = chain ? (i > 2 ? i - 2 : 0) : 0;
-      member.separation = chain ? arm : Eigen::VectorXd(static_cast<double>(rank) * arm);
-    }
+    FormationMember member = formationSlot(spec, separation, i);
     const Eigen::VectorXd& target_state =
         member.target == 0 ? leader_initial_state
                            : members[static_cast<std::size_t>(member.target - 1)].initial_state;
-    member.target_name =
-        member.target == 0 ? "leader" : members[static_cast<std::size_t>(member.target - 1)].name;
     member.initial_state = target_state - member.separation - initial_error;
     members.push_back(member);
   }
   return members;
+}
+
+FormationMember FollowerConfiguration::member(int index, const std::string& index_key) const {
+  if (index < 1 || index > formation.followers) {
+    throw ParameterError(index_key, "is " + std::to_string(index) + " but the formation has " +
+                                        std::to_string(formation.followers) + " follower(s)");
+  }
+  return formationSlot(formation, controller.separation, index);
 }
 
 ControllerParameters memberParameters(const ControllerParameters& parameters,

@@ -223,20 +223,18 @@ bool FollowerCycle::step(std::int64_t now_ns, std::int64_t stamp_ns, double dela
   out->own_state_fresh =
       design.parameters.time_headway > 0.0 && have_own_state_ &&
       ageOf(stamp_ns, own.stamp_ns, own.receipt_ns) <= settings_.measurement_timeout;
-  const DynamicFollowerStatus* status = nullptr;
-  if (mode_ == FollowerMode::kMeasurementLost) {
-    status = use_leader ? &controller_->stepFallback(leader_.value().acceleration)
-                        : &controller_->stepFallback();
-  } else {
+  DynamicStepInputs inputs;  // without a measurement the step runs the fallback
+  if (mode_ != FollowerMode::kMeasurementLost) {
     y_.noalias() = design.parameters.model.C * out->xi;
-    const GenericDimensions::InputVector& a = leader_.value().acceleration;
+    inputs.measurement.emplace(y_);
     if (out->own_state_fresh) {
-      status = use_leader ? &controller_->stepWithOwnState(y_, own.state, a)
-                          : &controller_->stepWithOwnState(y_, own.state);
-    } else {
-      status = use_leader ? &controller_->step(y_, a) : &controller_->step(y_);
+      inputs.own_state.emplace(own.state);
     }
   }
+  if (use_leader) {
+    inputs.leader_input.emplace(leader_.value().acceleration);
+  }
+  const DynamicFollowerStatus* status = &controller_->step(inputs);
   out->stepped = true;
   out->stamp_ns = stamp_ns;
   out->steps = steps_;

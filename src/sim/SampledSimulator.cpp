@@ -88,8 +88,7 @@ FormationSummary runFormation(const Scenario& scenario, const ControllerDesign& 
   AgentIntegrator<Dims> leader(model, scenario_design.period, scenario.leader_initial_state,
                                scenario.disturbance);
   const StateVector zero_disturbance = StateVector::Zero(n);
-  const bool share_disturbance = share_leader_input && p.leader_disturbance_shared;
-  const bool need_disturbance = share_disturbance || static_cast<bool>(observer);
+  const bool need_disturbance = p.leader_disturbance_shared || static_cast<bool>(observer);
   const typename Dims::StateGainMatrix input_pseudoinverse = scenario_design.input_pseudoinverse;
   // The link of the shared accelerations (L1)-(L3): agent 0 the leader, i follower i. Without a
   // link section a follower gets its target's acceleration of the same tick.
@@ -108,9 +107,8 @@ FormationSummary runFormation(const Scenario& scenario, const ControllerDesign& 
     if (need_disturbance) {
       scenario.disturbance.addTo(t, disturbance);
     }
-    const InputVector leader_acceleration =  // a_1 = u_1 (+ pinv(B) u_d)
-        share_disturbance ? leaderAcceleration(leader_input, input_pseudoinverse, disturbance)
-                          : leader_input;
+    const InputVector leader_acceleration = sharedLeaderAcceleration(  // a_1
+        p.leader_disturbance_shared, leader_input, input_pseudoinverse, disturbance);
     if (use_link) {
       link.send(0, tick, leader_acceleration);
     }
@@ -126,9 +124,11 @@ FormationSummary runFormation(const Scenario& scenario, const ControllerDesign& 
       const StateVector xi = target_state - follower.plant.state() - follower.separation;
       const OutputVector y = output_matrix * xi;
       const StateVector& own_state = follower.plant.state();
-      const auto& status = share_leader_input ? follower.controller.stepWithOwnState(
-                                                    y, own_state, target_acceleration)
-                                              : follower.controller.stepWithOwnState(y, own_state);
+      StepInputs<Dims> inputs{y, std::nullopt, own_state};
+      if (share_leader_input) {
+        inputs.leader_input = target_acceleration;
+      }
+      const auto& status = follower.controller.step(inputs);
       follower.command = status.command;
       if (use_link) {
         link.send(follower.member.index, tick, follower.command);

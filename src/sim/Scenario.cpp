@@ -3,7 +3,7 @@
 #include <cmath>
 #include <string>
 
-#include "../core/ValidationChecks.hpp"
+#include "projection_collision_avoidance/core/ValidationChecks.hpp"
 
 namespace projection_collision_avoidance {
 namespace {

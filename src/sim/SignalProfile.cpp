@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "../core/ValidationChecks.hpp"
+#include "projection_collision_avoidance/core/ValidationChecks.hpp"
 
 namespace projection_collision_avoidance {
 

@@ -41,7 +41,7 @@ void followerStep(benchmark::State& state, bool outside) {
   typename Dims::OutputVector y = Dims::OutputVector::Zero();
   y.template head<kAxes>().setConstant((outside ? 6.0 : 0.5) / std::sqrt(double(kAxes)));
   for (int k = 0; k < 1000; ++k) {  // warm-up: the estimate converges (onto the bound)
-    controller.step(y);
+    controller.step({y});
   }
   if (controller.status().projection_active != outside) {
     state.SkipWithError("the projection is not in the intended regime");
@@ -49,7 +49,7 @@ void followerStep(benchmark::State& state, bool outside) {
   }
   const long allocations_before = testing::allocationCount();
   for (auto _ : state) {
-    benchmark::DoNotOptimize(controller.step(y).command);
+    benchmark::DoNotOptimize(controller.step({y}).command);
   }
   const double steps = static_cast<double>(state.iterations());
   const long substeps = design.parameters.estimator_substeps;

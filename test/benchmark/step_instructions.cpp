@@ -27,10 +27,10 @@ double run(long steps, bool outside) {
   y.template head<kAxes>().setConstant((outside ? 6.0 : 0.5) / std::sqrt(double(kAxes)));
   double sum = 0.0;
   for (int k = 0; k < 1000; ++k) {  // the same warm-up as the benchmark
-    sum += controller.step(y).command(0);
+    sum += controller.step({y}).command(0);
   }
   for (long k = 0; k < steps; ++k) {
-    sum += controller.step(y).command(0);
+    sum += controller.step({y}).command(0);
   }
   return sum;
 }

@@ -4,8 +4,10 @@
 /// Parameter sets shared by the core tests.
 
 #include <string>
+#include <utility>
 
 #include "projection_collision_avoidance/core/ControllerParameters.hpp"
+#include "projection_collision_avoidance/core/DynamicFollowerController.hpp"
 #include "projection_collision_avoidance/scenario/ScenarioLoader.hpp"
 
 namespace projection_collision_avoidance {
@@ -32,6 +34,14 @@ inline ControllerParameters paperParameters() {
 
 inline std::string scenarioPath(const std::string& name) {
   return std::string(SCENARIO_DIR) + "/" + name;
+}
+
+/// Replaces @p controller by one of @p design that carries over its state, as the follower node
+/// does on reconfiguration (DynamicFollowerController::adoptStateOf()).
+inline void changeDesign(DynamicFollowerController* controller, const ControllerDesign& design) {
+  DynamicFollowerController replacement(design);
+  replacement.adoptStateOf(*controller);
+  *controller = std::move(replacement);
 }
 
 }  // namespace testing

@@ -130,9 +130,9 @@ TEST(CommandRateLimit, FirstCommandStartsFromRest) {
   Controller2D free_controller(free_design);
   Controller2D controller(design);
   const Eigen::Vector4d y(2.0, -1.0, 0.5, 0.3);
-  const Vector2 wanted = free_controller.step(y).command;
+  const Vector2 wanted = free_controller.step({y}).command;
   ASSERT_GT(wanted.norm(), 0.2);
-  const auto& status = controller.step(y);
+  const auto& status = controller.step({y});
   EXPECT_TRUE(status.command_rate_limited);
   EXPECT_FALSE(status.command_saturated);
   EXPECT_NEAR(status.command.norm(), 20.0 * design.period, 1e-15);
@@ -162,9 +162,10 @@ void checkBoundsAcrossModes(double acceleration_limit) {
   for (int k = 0; k < 3000; ++k) {
     const bool tracking = k % 100 < 60;
     const Eigen::Vector4d y = measurement.next(k);
-    const auto& s = tracking ? limited.step(y, leader_input) : limited.stepFallback(leader_input);
-    const Vector2 free_command =
-        tracking ? free.step(y, leader_input).command : free.stepFallback(leader_input).command;
+    const auto& s =
+        tracking ? limited.step({y, leader_input}) : limited.step({std::nullopt, leader_input});
+    const Vector2 free_command = tracking ? free.step({y, leader_input}).command
+                                          : free.step({std::nullopt, leader_input}).command;
     ASSERT_EQ(s.fallback, !tracking);
     ASSERT_LE(euclideanNorm(s.command - previous), max_change) << "tick " << k;
     ASSERT_LE(euclideanNorm(s.command), acceleration_limit) << "tick " << k;
@@ -226,7 +227,7 @@ TEST(CommandRateLimit, WithoutALimitTheLawIsUnchanged) {
     for (int k = 0; k < 1000; ++k) {
       const bool tracking = k % 100 < 60;
       const Eigen::Vector4d y = measurement.next(k);
-      const auto& s = tracking ? controller.step(y, u1) : controller.stepFallback(u1);
+      const auto& s = tracking ? controller.step({y, u1}) : controller.step({std::nullopt, u1});
       ASSERT_EQ(s.estimate, estimator.estimate()) << "tick " << k;
       Vector2 command;
       if (tracking) {
@@ -260,7 +261,7 @@ TEST(CommandRateLimit, EstimatorIntegratesTheActingCommandInTracking) {
   const Eigen::Vector2d estimate(0.3, -0.2);  // inside Omega_0: no projection
   const Eigen::Vector2d y(1.0, 0.5);
   controller.resetEstimate(estimate);
-  const auto& s = controller.step(y);
+  const auto& s = controller.step({y});
   ASSERT_TRUE(s.command_rate_limited);
   ASSERT_FALSE(s.projection_active);
   EXPECT_NEAR(std::abs(s.command(0)), 0.05, 1e-15);
@@ -288,7 +289,7 @@ TEST(CommandRateLimit, FallbackPredictsWithTheActingCommand) {
   Controller1D controller(design);
   const Eigen::Vector2d xi(0.0, -2.0);  // closing at 2 m/s: K_f xi_hat = -2 m/s^2
   controller.resetEstimate(xi);
-  const auto& s = controller.stepFallback();
+  const auto& s = controller.step({});
   ASSERT_TRUE(s.command_rate_limited);
   EXPECT_DOUBLE_EQ(s.fallback_command(0), -2.0);
   EXPECT_NEAR(s.command(0), -0.05, 1e-15);
@@ -304,25 +305,26 @@ TEST(CommandRateLimit, FallbackPredictsWithTheActingCommand) {
 TEST(CommandRateLimit, SetDesignKeepsThePreviousCommandAndResetClearsIt) {
   DynamicFollowerController controller(ControllerDesign::create(planarParameters(kInf, kInf)));
   const Eigen::Vector4d y(2.0, -1.0, 0.5, 0.3);
-  const Eigen::VectorXd before = controller.step(y).command;
+  const Eigen::VectorXd before = controller.step({y}).command;
   ASSERT_GT(before.norm(), 1.0);
   const ControllerDesign limited = ControllerDesign::create(planarParameters(20.0, kInf));
-  controller.setDesign(limited);
+  testing::changeDesign(&controller, limited);
   EXPECT_EQ(controller.previousCommand(), before);
   const Eigen::Vector4d far(-6.0, 5.0, -2.0, 1.0);
-  const DynamicFollowerStatus& next = controller.step(far);
+  const DynamicFollowerStatus& next = controller.step({far});
   EXPECT_TRUE(next.command_rate_limited);
   EXPECT_LE(euclideanNorm(next.command - before), 20.0 * limited.period);
   EXPECT_NEAR(euclideanNorm(next.command - before), 20.0 * limited.period, 1e-12);
 
   // A smaller acceleration limit moves the kept command into its ball.
   const Eigen::VectorXd kept = controller.previousCommand();
-  controller.setDesign(ControllerDesign::create(planarParameters(20.0, 0.5 * kept.norm())));
+  testing::changeDesign(&controller,
+                        ControllerDesign::create(planarParameters(20.0, 0.5 * kept.norm())));
   EXPECT_MATRIX_NEAR(controller.previousCommand(), 0.5 * kept, 1e-15);
 
   controller.reset();
   EXPECT_EQ(controller.previousCommand(), Eigen::VectorXd::Zero(2));
-  const DynamicFollowerStatus& restarted = controller.step(far);
+  const DynamicFollowerStatus& restarted = controller.step({far});
   EXPECT_NEAR(euclideanNorm(restarted.command), 20.0 * limited.period, 1e-12);
 }
 

@@ -55,19 +55,19 @@ void expectFallbackTwin(const Status& a, const Status& b) {
 
 // Bug (fuzzer, first seconds): a NaN or infinite y went into G y and the estimator, so the
 // command was NaN and the estimate NaN for good (moveIntoBound() does nothing on NaN). Now the
-// measurement counts as missing: the tick is stepFallback()'s, flagged.
+// measurement counts as missing: the tick is the fallback's (step({})), flagged.
 TEST(ControllerRobustness, NonFiniteMeasurementRunsTheFallback) {
   const ControllerDesign design = ControllerDesign::create(testing::paperParameters());
   for (const double bad : {kNaN, kInf, -kInf}) {
     Controller1D controller(design);
     Controller1D twin(design);
     for (int k = 0; k < 20; ++k) {
-      controller.step(Eigen::Vector2d(3.0, -0.5));
-      twin.step(Eigen::Vector2d(3.0, -0.5));
+      controller.step({Eigen::Vector2d(3.0, -0.5)});
+      twin.step({Eigen::Vector2d(3.0, -0.5)});
     }
     for (int k = 0; k < 5; ++k) {
-      const auto& status = controller.step(Eigen::Vector2d(1.0, bad));
-      const auto& expected = twin.stepFallback();
+      const auto& status = controller.step({Eigen::Vector2d(1.0, bad)});
+      const auto& expected = twin.step({});
       EXPECT_TRUE(status.measurement_rejected);
       EXPECT_TRUE(status.fallback);
       EXPECT_FALSE(expected.measurement_rejected);
@@ -75,8 +75,8 @@ TEST(ControllerRobustness, NonFiniteMeasurementRunsTheFallback) {
       ASSERT_TRUE(controller.estimate().allFinite());
     }
     // The next finite measurement resumes the laws from the predicted estimate.
-    const auto& status = controller.step(Eigen::Vector2d(3.0, -0.5));
-    const auto& expected = twin.step(Eigen::Vector2d(3.0, -0.5));
+    const auto& status = controller.step({Eigen::Vector2d(3.0, -0.5)});
+    const auto& expected = twin.step({Eigen::Vector2d(3.0, -0.5)});
     EXPECT_FALSE(status.measurement_rejected);
     EXPECT_FALSE(status.fallback);
     EXPECT_MATRIX_NEAR(status.command, expected.command, 0.0);
@@ -87,14 +87,14 @@ TEST(ControllerRobustness, NonFiniteMeasurementRunsTheFallback) {
 TEST(ControllerRobustness, NonFiniteFirstMeasurementLeavesTheControllerUninitialised) {
   const ControllerDesign design = ControllerDesign::create(testing::paperParameters());
   DynamicFollowerController controller(design);
-  const auto& status = controller.step(Eigen::Vector2d(kNaN, 0.0));
+  const auto& status = controller.step({Eigen::Vector2d(kNaN, 0.0)});
   EXPECT_TRUE(status.measurement_rejected);
   EXPECT_TRUE(status.fallback);
   EXPECT_TRUE(status.command.isZero());  // the fallback from the zero estimate
   // The first finite measurement initialises the estimate from itself, as without the NaN.
-  controller.step(Eigen::Vector2d(2.0, 0.5));
+  controller.step({Eigen::Vector2d(2.0, 0.5)});
   DynamicFollowerController fresh(design);
-  fresh.step(Eigen::Vector2d(2.0, 0.5));
+  fresh.step({Eigen::Vector2d(2.0, 0.5)});
   EXPECT_MATRIX_NEAR(controller.estimate(), fresh.estimate(), 0.0);
   EXPECT_FALSE(controller.status().measurement_rejected);
 }
@@ -110,16 +110,16 @@ TEST(ControllerRobustness, NonFiniteLeaderInputIsTakenAsUnknown) {
   const Eigen::Vector2d y(1.5, -0.3);
   const Eigen::VectorXd bad = Eigen::VectorXd::Constant(1, kNaN);
   for (int k = 0; k < 10; ++k) {
-    const DynamicFollowerStatus& status = controller.step(y, bad);
-    const DynamicFollowerStatus& expected = twin.step(y);
+    const DynamicFollowerStatus& status = controller.step({y, bad});
+    const DynamicFollowerStatus& expected = twin.step({y});
     EXPECT_TRUE(status.leader_input_rejected);
     EXPECT_FALSE(status.measurement_rejected);
     EXPECT_MATRIX_NEAR(status.command, expected.command, 0.0);
     EXPECT_MATRIX_NEAR(status.feedforward_command, Eigen::VectorXd::Zero(1), 0.0);
   }
-  const DynamicFollowerStatus& status = controller.stepFallback(bad);
+  const DynamicFollowerStatus& status = controller.step({std::nullopt, bad});
   EXPECT_TRUE(status.leader_input_rejected);
-  EXPECT_MATRIX_NEAR(status.command, twin.stepFallback().command, 0.0);
+  EXPECT_MATRIX_NEAR(status.command, twin.step({}).command, 0.0);
   EXPECT_MATRIX_NEAR(controller.estimate(), twin.estimate(), 0.0);
 }
 
@@ -133,10 +133,10 @@ TEST(ControllerRobustness, HugeFiniteMeasurementGivesTheFallbackCommand) {
     const ControllerDesign design = ControllerDesign::create(p);
     Controller1D controller(design);
     Controller1D twin(design);
-    controller.step(Eigen::Vector2d(3.0, 1.0));
-    twin.step(Eigen::Vector2d(3.0, 1.0));
-    const auto& status = controller.step(Eigen::Vector2d(kLargest, -kLargest));
-    const auto& expected = twin.stepFallback();
+    controller.step({Eigen::Vector2d(3.0, 1.0)});
+    twin.step({Eigen::Vector2d(3.0, 1.0)});
+    const auto& status = controller.step({Eigen::Vector2d(kLargest, -kLargest)});
+    const auto& expected = twin.step({});
     EXPECT_TRUE(status.command_overflow);
     EXPECT_TRUE(status.fallback);
     EXPECT_FALSE(status.measurement_rejected);
@@ -144,7 +144,7 @@ TEST(ControllerRobustness, HugeFiniteMeasurementGivesTheFallbackCommand) {
     EXPECT_TRUE(status.command.allFinite());
     EXPECT_LE(euclideanNorm(controller.estimate()), design.xi_max);
     // Back to ordinary values: the laws again.
-    EXPECT_FALSE(controller.step(Eigen::Vector2d(3.0, 1.0)).fallback);
+    EXPECT_FALSE(controller.step({Eigen::Vector2d(3.0, 1.0)}).fallback);
   }
 }
 
@@ -158,7 +158,7 @@ TEST(ControllerRobustness, SaturationKeepsTheDirectionOfAHugeCommand) {
   const ControllerDesign design = ControllerDesign::create(p);
   Controller2D controller(design);
   // G y = [1e308, 1e308]: finite, its norm is not.
-  const auto& status = controller.step(Eigen::Vector4d(1e308, 1e308, 0.0, 0.0));
+  const auto& status = controller.step({Eigen::Vector4d(1e308, 1e308, 0.0, 0.0)});
   EXPECT_FALSE(status.command_overflow);
   EXPECT_TRUE(status.command_saturated);
   EXPECT_MATRIX_NEAR(status.command, Eigen::Vector2d::Constant(std::sqrt(2.0)), 1e-15);
@@ -173,7 +173,7 @@ TEST(ControllerRobustness, HugeFallbackGainGivesTheFeedforwardCommand) {
   const ControllerDesign design = ControllerDesign::create(p);
   Controller1D controller(design);
   controller.resetEstimate(Eigen::Vector2d(0.0, 3.0));
-  const auto& status = controller.stepFallback(Eigen::Matrix<double, 1, 1>(0.5));
+  const auto& status = controller.step({std::nullopt, Eigen::Matrix<double, 1, 1>(0.5)});
   EXPECT_TRUE(status.command_overflow);
   EXPECT_DOUBLE_EQ(status.command(0), 0.5);
   EXPECT_EQ(status.fallback_command(0), 0.0);
@@ -243,7 +243,7 @@ TEST(ControllerRobustness, BoundHoldsInEveryNormEvaluation) {
   std::mt19937 rng(7);
   for (int k = 0; k < 3000; ++k) {
     const Eigen::VectorXd y = testing::randomVector(rng, 6, 5.0);
-    controller.step(y);
+    controller.step({y});
     const Eigen::VectorXd estimate = controller.estimate();
     ASSERT_LE(estimate.norm(), design.xi_max) << "step " << k;
     ASSERT_LE(std::sqrt(estimate.array().square().sum()), design.xi_max) << "step " << k;
@@ -297,7 +297,7 @@ TEST(ControllerRobustness, SubnormalAccelerationLimitSaturatesQuickly) {
   p.acceleration_limit = 0x0.4ffffff009fcap-1022;
   const ControllerDesign design = ControllerDesign::create(p);
   Controller1D controller(design);
-  const auto& status = controller.step(Eigen::Vector2d(1e12, -3e11));
+  const auto& status = controller.step({Eigen::Vector2d(1e12, -3e11)});
   EXPECT_TRUE(status.command_saturated);
   EXPECT_LE(euclideanNorm(status.command), p.acceleration_limit);
   EXPECT_GT(status.command(0), 0.0);

@@ -64,8 +64,8 @@ TEST(DynamicFollowerController, MatchesTheFixedSizeController) {
   for (int k = 0; k < 500; ++k) {
     SCOPED_TRACE(::testing::Message() << "step " << k);
     const Eigen::Vector4d y(0.01 * k, -0.02 * k, std::sin(0.1 * k), 0.3);
-    const auto& a = runtime.step(y);
-    const auto& b = fixed.step(y);
+    const auto& a = runtime.step({y});
+    const auto& b = fixed.step({y});
     expectSameStatus(a, b, 0.0);
     ASSERT_FALSE(HasFailure());
   }
@@ -86,10 +86,10 @@ TEST(DynamicFollowerController, OwnStateAndSharedInputMatchTheFixedSizeControlle
     const Eigen::Vector2d own_state(0.1 * k, 2.0 * std::cos(0.03 * k));
     const Eigen::Matrix<double, 1, 1> leader_input(std::sin(0.2 * k));
     const bool shared = k % 3 != 0;
-    const auto& a = shared ? runtime.stepWithOwnState(y, own_state, leader_input)
-                           : runtime.stepWithOwnState(y, own_state);
-    const auto& b = shared ? fixed.stepWithOwnState(y, own_state, leader_input)
-                           : fixed.stepWithOwnState(y, own_state);
+    const auto& a = shared ? runtime.step({y, leader_input, own_state})
+                           : runtime.step({y, std::nullopt, own_state});
+    const auto& b = shared ? fixed.step({y, leader_input, own_state})
+                           : fixed.step({y, std::nullopt, own_state});
     expectSameStatus(a, b, 0.0);
     ASSERT_FALSE(HasFailure());
   }
@@ -146,11 +146,11 @@ Occurrences runMixedSequence(const ControllerDesign& design) {
     const DynamicFollowerStatus* a = nullptr;
     const FollowerControllerStatus<Dims>* b = nullptr;
     if (in_fallback) {
-      a = shared ? &runtime.stepFallback(leader_input) : &runtime.stepFallback();
-      b = shared ? &fixed.stepFallback(u_fixed) : &fixed.stepFallback();
+      a = shared ? &runtime.step({std::nullopt, leader_input}) : &runtime.step({});
+      b = shared ? &fixed.step({std::nullopt, u_fixed}) : &fixed.step({});
     } else {
-      a = shared ? &runtime.step(y, leader_input) : &runtime.step(y);
-      b = shared ? &fixed.step(y_fixed, u_fixed) : &fixed.step(y_fixed);
+      a = shared ? &runtime.step({y, leader_input}) : &runtime.step({y});
+      b = shared ? &fixed.step({y_fixed, u_fixed}) : &fixed.step({y_fixed});
     }
     expectSameStatus(*a, *b, 0.0);
     if (::testing::Test::HasFailure()) {
@@ -225,44 +225,45 @@ TEST(DynamicFollowerController, SetDesignKeepsTheEstimateInsideTheNewBound) {
   for (int k = 0; k < 200; ++k) {
     SCOPED_TRACE(::testing::Message() << "step " << k);
     // far outside: the estimate saturates at 4 m
-    expectSameStatus(controller.step(Eigen::Vector2d(6.0, 0.0)),
-                     fixed.step(Eigen::Vector2d(6.0, 0.0)), 0.0);
+    expectSameStatus(controller.step({Eigen::Vector2d(6.0, 0.0)}),
+                     fixed.step({Eigen::Vector2d(6.0, 0.0)}), 0.0);
     ASSERT_FALSE(HasFailure());
   }
   EXPECT_NEAR(controller.estimate().norm(), 4.0, 1e-6);
   p.alpha = 0.5;  // xi_max = 2.5 m
   p.tracker_enabled = false;
   p.acceleration_limit = 3.0;  // below G y: the next command saturates
-  p.jerk_limit = 100.0;        // from the previous command, which setDesign() keeps
-  controller.setDesign(ControllerDesign::create(p));
-  // setDesign() by hand on a fixed-size controller: the estimate and the previous command carry
-  // over, each moved into the new bound.
+  p.jerk_limit = 100.0;        // from the previous command, which adoptStateOf() keeps
+  testing::changeDesign(&controller, ControllerDesign::create(p));
+  // The same on a fixed-size controller: the estimate and the previous command carry over, each
+  // moved into the new bound.
   FollowerController<DoubleIntegrator1D> fixed_after(ControllerDesign::create(p));
-  fixed_after.setPreviousCommand(fixed.previousCommand());
-  fixed_after.resetEstimate(fixed.estimate());
+  fixed_after.adoptStateOf(fixed);
   EXPECT_LE(controller.estimate().norm(), 2.5);
   EXPECT_NEAR(controller.estimate().norm(), 2.5, 1e-12);
   EXPECT_FALSE(controller.design().parameters.tracker_enabled);
-  const auto& status = controller.step(Eigen::Vector2d(6.0, 0.0));
+  const auto& status = controller.step({Eigen::Vector2d(6.0, 0.0)});
   EXPECT_TRUE(status.tracker_command.isZero());
-  expectSameStatus(status, fixed_after.step(Eigen::Vector2d(6.0, 0.0)), 0.0);
+  expectSameStatus(status, fixed_after.step({Eigen::Vector2d(6.0, 0.0)}), 0.0);
   EXPECT_TRUE(status.command_saturated);
   for (int k = 0; k < 50; ++k) {
-    SCOPED_TRACE(::testing::Message() << "step " << k << " after setDesign()");
+    SCOPED_TRACE(::testing::Message() << "step " << k << " after adoptStateOf()");
     const Eigen::Vector2d y(-1.0, 2.0);
     if (k % 2 == 0) {
-      expectSameStatus(controller.stepFallback(), fixed_after.stepFallback(), 0.0);
+      expectSameStatus(controller.step({}), fixed_after.step({}), 0.0);
     } else {
-      expectSameStatus(controller.step(y), fixed_after.step(y), 0.0);
+      expectSameStatus(controller.step({y}), fixed_after.step({y}), 0.0);
     }
     ASSERT_FALSE(HasFailure());
   }
   p.model = makeDoubleIntegrator(2);
   p.separation = Eigen::Vector4d(5.0, 0.0, 0.0, 0.0);
-  EXPECT_THROW(controller.setDesign(ControllerDesign::create(
-                   embedAlongDirection(loadScenarioFile(testing::scenarioPath("paper_run2.yaml")),
-                                       Eigen::Vector2d(1.0, 0.0))
-                       .controller)),
+  EXPECT_THROW(testing::changeDesign(
+                   &controller, ControllerDesign::create(
+                                    embedAlongDirection(
+                                        loadScenarioFile(testing::scenarioPath("paper_run2.yaml")),
+                                        Eigen::Vector2d(1.0, 0.0))
+                                        .controller)),
                std::invalid_argument);
 }
 

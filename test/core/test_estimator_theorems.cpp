@@ -52,7 +52,7 @@ TEST(Theorem31, EstimationErrorDecaysAtTheProvenRateWithXiAtRest) {
         const double e = controller.estimate().norm();  // xi = 0, so e = xi_hat
         ASSERT_LE(e, k0 * std::exp(-0.5 * mu * t) * e0 * (1.0 + 1e-9))
             << "trial " << trial << " t=" << t;
-        projected_periods += controller.step(Eigen::Vector2d::Zero()).projection_active ? 1 : 0;
+        projected_periods += controller.step({Eigen::Vector2d::Zero()}).projection_active ? 1 : 0;
       }
     }
     if (p.estimator_gain(0, 1) > 0.0) {  // the skewed design
@@ -82,7 +82,7 @@ TEST(Theorem31, EstimationErrorDecaysAtTheProvenRateWithXiMoving) {
       ASSERT_LE(xi.norm(), design.xi_soft);  // the theorem's hypothesis
       ASSERT_LE((controller.estimate() - xi).norm(), k0 * std::exp(-0.5 * mu * t) * e0)
           << "trial " << trial << " t=" << t;
-      projected_periods += controller.step(xi).projection_active ? 1 : 0;
+      projected_periods += controller.step({xi}).projection_active ? 1 : 0;
       xi = step * xi;  // tracker off and no leader input: xi' = A_c xi
     }
   }

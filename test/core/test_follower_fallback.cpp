@@ -1,4 +1,4 @@
-/// The fallback of a follower that has lost its measurement (FollowerController::stepFallback()),
+/// The fallback of a follower that has lost its measurement (FollowerController::step() without a measurement),
 /// its parameters, and the choice of mode from the ages of the inputs (selectFollowerMode()).
 
 #include <cmath>
@@ -36,7 +36,7 @@ TEST(FollowerFallback, DefaultGainBrakesTheRelativeVelocity) {
   Eigen::Vector2d xi(1.0, 0.8);
   controller.resetEstimate(xi);
   for (int k = 0; k < 1000; ++k) {  // 10 s at 100 Hz
-    const auto& status = controller.stepFallback();
+    const auto& status = controller.step({});
     ASSERT_TRUE(status.fallback);
     ASSERT_EQ(status.baseline_command(0), 0.0);
     ASSERT_EQ(status.tracker_command(0), 0.0);
@@ -60,7 +60,7 @@ TEST(FollowerFallback, EstimateStaysInsideTheBound) {
   controller.resetEstimate(Eigen::Vector2d(3.5, 1.5));  // 3.81 m, moving outward
   bool projected = false;
   for (int k = 0; k < 500; ++k) {
-    const auto& status = controller.stepFallback();
+    const auto& status = controller.step({});
     ASSERT_LE(controller.estimate().norm(), design.xi_max) << "step " << k;
     ASSERT_EQ(status.command(0), 0.0);
     projected = projected || status.projection_active;
@@ -76,7 +76,7 @@ TEST(FollowerFallback, CommandIsSaturated) {
   Controller1D controller(design);
   controller.resetEstimate(Eigen::Vector2d(0.0, -2.0));  // closing at 2 m/s
   Eigen::Vector2d xi(0.0, -2.0);
-  const auto& first = controller.stepFallback();
+  const auto& first = controller.step({});
   EXPECT_TRUE(first.command_saturated);
   EXPECT_DOUBLE_EQ(first.command(0), -0.25);
   EXPECT_DOUBLE_EQ(first.fallback_command(0), -2.0);
@@ -95,7 +95,7 @@ TEST(FollowerFallback, SharedLeaderInputIsMatched) {
   controller.resetEstimate(xi);
   const Eigen::Matrix<double, 1, 1> leader_input(-1.5);  // the leader brakes
   for (int k = 0; k < 300; ++k) {
-    const auto& status = controller.stepFallback(leader_input);
+    const auto& status = controller.step({std::nullopt, leader_input});
     ASSERT_DOUBLE_EQ(status.feedforward_command(0), -1.5);
     ASSERT_NEAR(status.command(0), -1.5, 1e-9);  // the relative velocity stays zero
     xi = relativeStep(xi, leader_input(0) - status.command(0), design.period);
@@ -110,7 +110,7 @@ TEST(FollowerFallback, UnsharedLeaderInputIsNotPredicted) {
   p.leader_input_in_command = true;
   Controller1D controller(ControllerDesign::create(p));
   controller.resetEstimate(Eigen::Vector2d(0.5, 0.0));
-  const auto& status = controller.stepFallback(Eigen::Matrix<double, 1, 1>(2.0));
+  const auto& status = controller.step({std::nullopt, Eigen::Matrix<double, 1, 1>(2.0)});
   EXPECT_DOUBLE_EQ(status.command(0), 2.0);
   EXPECT_MATRIX_NEAR(controller.estimate(), Eigen::Vector2d(0.5, 0.0), 1e-12);
 }
@@ -119,12 +119,12 @@ TEST(FollowerFallback, NextMeasurementResumesTheLaws) {
   const ControllerDesign design = ControllerDesign::create(testing::paperParameters());
   Controller1D controller(design);
   const Eigen::Vector2d y(1.0, 0.2);
-  controller.step(y);
+  controller.step({y});
   for (int k = 0; k < 50; ++k) {
-    controller.stepFallback();
+    controller.step({});
   }
   const Eigen::Vector2d predicted = controller.estimate();
-  const auto& status = controller.step(y);
+  const auto& status = controller.step({y});
   EXPECT_FALSE(status.fallback);
   EXPECT_EQ(status.fallback_command(0), 0.0);
   EXPECT_MATRIX_NEAR(status.estimate, predicted, 0.0);  // the estimate carries over
@@ -136,18 +136,19 @@ TEST(FollowerFallback, RuntimeControllerDispatches) {
   DynamicFollowerController runtime(design);
   Controller1D fixed(design);
   const Eigen::Vector2d y(2.0, -0.5);
-  runtime.step(y);
-  fixed.step(y);
+  runtime.step({y});
+  fixed.step({y});
   for (int k = 0; k < 100; ++k) {
-    const auto& a = runtime.stepFallback();
-    const auto& b = fixed.stepFallback();
+    const auto& a = runtime.step({});
+    const auto& b = fixed.step({});
     ASSERT_TRUE(a.fallback);
     ASSERT_MATRIX_NEAR(a.command, b.command, 0.0);
     ASSERT_MATRIX_NEAR(a.fallback_command, b.fallback_command, 0.0);
     ASSERT_MATRIX_NEAR(a.estimate, b.estimate, 0.0);
   }
   const Eigen::Matrix<double, 1, 1> u1(0.5);
-  EXPECT_MATRIX_NEAR(runtime.stepFallback(u1).command, fixed.stepFallback(u1).command, 0.0);
+  EXPECT_MATRIX_NEAR(runtime.step({std::nullopt, u1}).command,
+                     fixed.step({std::nullopt, u1}).command, 0.0);
 }
 
 void expectRefused(const ControllerParameters& p, const std::string& key) {

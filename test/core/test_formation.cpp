@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include "projection_collision_avoidance/core/FollowerConfiguration.hpp"
 #include "projection_collision_avoidance/core/Formation.hpp"
 #include "projection_collision_avoidance/core/ParameterError.hpp"
 #include "projection_collision_avoidance/scenario/ScenarioLoader.hpp"
@@ -88,6 +89,39 @@ TEST(FormationLayout, VArmsTurnTheSeparationBothWays) {
     EXPECT_EQ(chain[i - 1].target, i > 2 ? i - 2 : 0);
     // The star and the chain put every follower on the same slot.
     EXPECT_MATRIX_NEAR(star[i - 1].initial_state, chain[i - 1].initial_state, 1e-12) << i;
+  }
+}
+
+// A follower configured alone (FollowerConfiguration, as the follower node is) gets the slot,
+// target and name that the layout of the whole formation gives it.
+TEST(FormationLayout, OneMembersSlotIsItsSlotInTheLayout) {
+  Eigen::VectorXd d = Eigen::VectorXd::Zero(4);
+  d(0) = 5.0;
+  for (const FormationTopology topology : {FormationTopology::kStar, FormationTopology::kChain}) {
+    for (const FormationShape shape : {FormationShape::kLine, FormationShape::kV}) {
+      FollowerConfiguration configuration;
+      configuration.controller.separation = d;
+      configuration.formation.configured = true;
+      configuration.formation.followers = 7;
+      configuration.formation.topology = topology;
+      configuration.formation.shape = shape;
+      const auto all = layout(topology, shape, 7, d);
+      for (int i = 1; i <= 7; ++i) {
+        const FormationMember one = configuration.member(i, "~formation_index");
+        EXPECT_EQ(one.name, all[i - 1].name);
+        EXPECT_EQ(one.target, all[i - 1].target);
+        EXPECT_EQ(one.target_name, all[i - 1].target_name);
+        EXPECT_EQ(one.separation, all[i - 1].separation) << i;
+      }
+      for (const int outside : {0, 8}) {
+        try {
+          configuration.member(outside, "~formation_index");
+          ADD_FAILURE() << "index " << outside << " accepted";
+        } catch (const ParameterError& error) {
+          EXPECT_EQ(error.key(), "~formation_index");
+        }
+      }
+    }
   }
 }
 

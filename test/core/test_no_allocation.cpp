@@ -39,13 +39,13 @@ long allocationsDuringSteps(const ControllerDesign& design, int steps,
   int limited = 0;
   for (int k = 0; k < steps; ++k) {
     y.setConstant((k / 50) % 2 == 0 ? 0.2 : 7.0);
-    sink += controller.step(y).command(0);
+    sink += controller.step({y}).command(0);
     limited += controller.status().command_rate_limited ? 1 : 0;
-    sink += controller.step(y, u1).command(0);
+    sink += controller.step({y, u1}).command(0);
     limited += controller.status().command_rate_limited ? 1 : 0;
-    sink += controller.stepFallback().command(0);
+    sink += controller.step({}).command(0);
     limited += controller.status().command_rate_limited ? 1 : 0;
-    sink += controller.stepFallback(u1).command(0);
+    sink += controller.step({std::nullopt, u1}).command(0);
     limited += controller.status().command_rate_limited ? 1 : 0;
   }
   const long after = testing::allocationCount();
@@ -94,14 +94,14 @@ TEST(NoAllocation, ControlStepsOfTheRuntimeController) {
     DynamicFollowerController controller(designFor(axes, true));
     Eigen::VectorXd y = Eigen::VectorXd::Constant(2 * axes, 0.2);
     const Eigen::VectorXd u1 = Eigen::VectorXd::Constant(axes, 0.3);
-    controller.step(y);
+    controller.step({y});
     const long before = testing::allocationCount();
     for (int k = 0; k < 1000; ++k) {
       y.setConstant((k / 50) % 2 == 0 ? 0.2 : 7.0);
-      controller.step(y);
-      controller.step(y, u1);
-      controller.stepFallback();
-      controller.stepFallback(u1);
+      controller.step({y});
+      controller.step({y, u1});
+      controller.step({});
+      controller.step({std::nullopt, u1});
     }
     EXPECT_EQ(testing::allocationCount() - before, 0) << axes << " axes";
   }
@@ -130,13 +130,13 @@ TEST(NoAllocation, ControlStepsWithTheRateLimitActive) {
   DynamicFollowerController runtime(designFor(2, true, 5.0));
   Eigen::VectorXd y = Eigen::VectorXd::Constant(4, 0.2);
   const Eigen::VectorXd u1 = Eigen::VectorXd::Constant(2, 0.3);
-  runtime.step(y);
+  runtime.step({y});
   int limited = 0;
   const long before = testing::allocationCount();
   for (int k = 0; k < 1000; ++k) {
     y.setConstant((k / 50) % 2 == 0 ? 0.2 : 7.0);
-    limited += runtime.step(y, u1).command_rate_limited ? 1 : 0;
-    limited += runtime.stepFallback(u1).command_rate_limited ? 1 : 0;
+    limited += runtime.step({y, u1}).command_rate_limited ? 1 : 0;
+    limited += runtime.step({std::nullopt, u1}).command_rate_limited ? 1 : 0;
   }
   EXPECT_EQ(testing::allocationCount() - before, 0);
   EXPECT_GT(limited, 100);

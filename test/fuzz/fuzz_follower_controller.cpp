@@ -514,9 +514,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       case 5: {
         const Eigen::VectorXd y = vectorValue(in, p, scale, header.non_finite);
         for (int r = 0; r < repeat && tick < kMaxTicks; ++r, ++tick) {
-          check(controller.step(y), controller.estimate(), controller.design(), tick);
+          check(controller.step({y}), controller.estimate(), controller.design(), tick);
           if (shadow) {
-            check(shadow->step(y), shadow->estimate(), shadow->design(), tick);
+            check(shadow->step({y}), shadow->estimate(), shadow->design(), tick);
           }
         }
         break;
@@ -528,9 +528,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         const Eigen::VectorXd y = vectorValue(in, p, scale, header.non_finite);
         const Eigen::VectorXd u1 = vectorValue(in, m, scale, header.non_finite);
         for (int r = 0; r < repeat && tick < kMaxTicks; ++r, ++tick) {
-          check(controller.step(y, u1), controller.estimate(), controller.design(), tick);
+          check(controller.step({y, u1}), controller.estimate(), controller.design(), tick);
           if (shadow) {
-            check(shadow->step(y, u1), shadow->estimate(), shadow->design(), tick);
+            check(shadow->step({y, u1}), shadow->estimate(), shadow->design(), tick);
           }
         }
         break;
@@ -538,18 +538,19 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       case 10:
       case 11:
         for (int r = 0; r < repeat && tick < kMaxTicks; ++r, ++tick) {
-          check(controller.stepFallback(), controller.estimate(), controller.design(), tick);
+          check(controller.step({}), controller.estimate(), controller.design(), tick);
           if (shadow) {
-            check(shadow->stepFallback(), shadow->estimate(), shadow->design(), tick);
+            check(shadow->step({}), shadow->estimate(), shadow->design(), tick);
           }
         }
         break;
       case 12: {
         const Eigen::VectorXd u1 = vectorValue(in, m, scale, header.non_finite);
         for (int r = 0; r < repeat && tick < kMaxTicks; ++r, ++tick) {
-          check(controller.stepFallback(u1), controller.estimate(), controller.design(), tick);
+          check(controller.step({std::nullopt, u1}), controller.estimate(), controller.design(),
+                tick);
           if (shadow) {
-            check(shadow->stepFallback(u1), shadow->estimate(), shadow->design(), tick);
+            check(shadow->step({std::nullopt, u1}), shadow->estimate(), shadow->design(), tick);
           }
         }
         break;
@@ -565,21 +566,20 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         } catch (const pca::ParameterError&) {
           break;  // refused: the old design stays
         }
-        controller.setDesign(*next);
+        pca::DynamicFollowerController replacement(*next);  // state carried over
+        replacement.adoptStateOf(controller);
+        controller = std::move(replacement);
         if (shadow) {
-          const bool initialized = shadow->initialized();
-          const Eigen::VectorXd kept = shadow->estimate();
-          shadow.emplace(*next);
-          if (initialized) {
-            shadow->resetEstimate(kept);
-          }
+          Shadow shadow_replacement(*next);
+          shadow_replacement.adoptStateOf(*shadow);
+          shadow.emplace(shadow_replacement);
           if (!(boundNorm(shadow->estimate()) <= next->xi_max)) {
             fail("shadow: ||xi_hat|| > xi_max after a new design", tick);
           }
         }
         if (!controller.estimate().allFinite() ||
             !(boundNorm(controller.estimate()) <= next->xi_max)) {
-          fail("||xi_hat|| > xi_max after setDesign", tick);
+          fail("||xi_hat|| > xi_max after adoptStateOf", tick);
         }
         ++tick;
         break;

@@ -13,7 +13,12 @@ mkdir -p "$out"
 run() {
   local name=$1
   shift
-  "$bin" "$@" --csv "$out/$name.csv" 2>&1 | sed -E 's/ wall_s=[0-9.e+-]+//' > "$out/$name.txt"
+  local status=0
+  "$bin" "$@" --csv "$out/$name.csv" > "$out/$name.raw" 2>&1 || status=$?
+  # A run cf_sim refuses (exit 2, the key named) is an output too: its message and exit status.
+  sed -E 's/ wall_s=[0-9.e+-]+//' "$out/$name.raw" > "$out/$name.txt"
+  rm -f "$out/$name.raw"
+  echo "exit=$status" >> "$out/$name.txt"
 }
 L=(--set controller.leader_information.command=true --set controller.leader_information.estimator=true
    --set controller.leader_information.disturbance=true)

@@ -1,13 +1,14 @@
 #pragma once
 
+#include "projection_collision_avoidance/core/AugmentedLaw.hpp"
 #include "projection_collision_avoidance/core/BallConstraint.hpp"
 #include "projection_collision_avoidance/core/CollisionFreeEstimator.hpp"
-#include "projection_collision_avoidance/core/CollisionFreeTracker.hpp"
 #include "projection_collision_avoidance/core/CommandRateLimiter.hpp"
 #include "projection_collision_avoidance/core/ControllerDesign.hpp"
 #include "projection_collision_avoidance/core/FollowerControllerStatus.hpp"
 #include "projection_collision_avoidance/core/PaperLaws.hpp"
 #include "projection_collision_avoidance/core/PlatoonLaws.hpp"
+#include "projection_collision_avoidance/core/StepInputs.hpp"
 #include "projection_collision_avoidance/core/TypeDefs.hpp"
 
 namespace projection_collision_avoidance {
@@ -23,9 +24,9 @@ namespace projection_collision_avoidance {
 /// command (CommandRateLimiter; zero before the first tick). The estimate is then integrated
 /// over [t, t + T] with y held and the augmentation that actually acts, u_2 - G y - u_ff (u_a
 /// [+ K_h x_2] when neither limit acted), so that its model of xi' stays that of the plant. Without
-/// a measurement stepFallback() brakes relative to the leader from the predicted estimate instead,
-/// under the same two limits, so that a change of mode cannot jump the command. A step allocates
-/// no memory.
+/// a measurement the step runs the fallback, which brakes relative to the leader from the
+/// predicted estimate instead, under the same two limits, so that a change of mode cannot jump the
+/// command. A step allocates no memory.
 ///
 /// Whatever the inputs, after every call the command is finite with euclideanNorm(u_2) <=
 /// acceleration_limit and euclideanNorm(u_2 - u_2 of the previous call) <= jerk_limit T, and
@@ -36,6 +37,7 @@ namespace projection_collision_avoidance {
 template <typename Dims>
 class FollowerController {
  public:
+  using Dimensions = Dims;
   using StateVector = typename Dims::StateVector;
   using InputVector = typename Dims::InputVector;
   using OutputVector = typename Dims::OutputVector;
@@ -44,16 +46,13 @@ class FollowerController {
   explicit FollowerController(const ControllerDesign& design)
       : design_(design),
         estimator_(design),
-        tracker_(design),
+        law_(design),
         input_matrix_(design.parameters.model.B),
         output_matrix_(design.parameters.model.C),
-        baseline_gain_(design.parameters.baseline_gain),
         output_pseudoinverse_(design.output_pseudoinverse),
         fallback_gain_(design.fallback_gain),
-        headway_gain_(design.headway_gain),
         feedforward_filter_(design.parameters.feedforward_gain, design.feedforward_smoothing,
                             design.parameters.model.inputDimension()),
-        headway_(design.parameters.time_headway > 0.0),
         rate_limiter_(design.parameters.jerk_limit, design.period,
                       design.parameters.acceleration_limit,
                       design.parameters.model.inputDimension()) {
@@ -66,60 +65,32 @@ class FollowerController {
     status_.estimate = estimator_.estimate();
   }
 
-  /// One control period without leader information (u_1 taken as unknown).
+  /// One control period T with what the follower knows at this tick (@p inputs):
   ///
-  /// A measurement with a non-finite entry (NaN, +-inf) does not reach the laws or the
-  /// estimator: it counts as missing, the tick runs the fallback exactly as stepFallback() does,
-  /// and status.measurement_rejected (with status.fallback) says so. A finite measurement so
-  /// large that the laws' command G y + u_a + u_ff overflows runs the fallback as well, flagged
-  /// status.command_overflow. So the command is always finite with ||u_2|| <=
-  /// acceleration_limit (in euclideanNorm()), and the estimate finite with ||xi_hat|| <= xi_max.
-  /// @param y relative measurement C (x_1 - x_2 - d)
+  /// - with a measurement y = C (x_1 - x_2 - d), the laws (2), (19), (10) and the estimator (11);
+  ///   a y with a non-finite entry (NaN, +-inf) does not reach them: it counts as missing
+  ///   (status.measurement_rejected), and so does a finite y so large that the laws' command
+  ///   overflows (status.command_overflow);
+  /// - without one (or a y counted as missing), the fallback: the command brakes relative to the
+  ///   leader from the estimate, which is predicted by the model alone and stays in Omega_1:
+  ///     u_2 = rate(sat(u_ff + K_f xi_hat)),   xi_hat' = Proj(A xi_hat + B (u_1m - u_2)),
+  ///   with u_ff and u_1m the leader input as shared into the command and the estimator (0 when
+  ///   unknown). For the default K_f = [0, k_v I] of a double integrator the predicted relative
+  ///   velocity decays as e^{-k_v t}. Before any measurement the estimate is zero. If u_ff + K_f
+  ///   xi_hat overflows (huge gains), the command is u_ff alone (command_overflow).
+  ///
+  /// The leader's input u_1 (its acceleration a_1) is used as configured by
+  /// leader_input_in_command / leader_input_in_estimator; one with a non-finite entry is taken as
+  /// unknown for this tick (status.leader_input_rejected). The own state x_2 lets the time
+  /// headway (S1) act (time_headway > 0; a non-finite or absent x_2 leaves it out). So the
+  /// command is always finite with ||u_2|| <= acceleration_limit (in euclideanNorm()), and the
+  /// estimate finite with ||xi_hat|| <= xi_max.
   /// @return the status of this tick; status.command is u_2 (m/s^2 for double integrators)
-  const FollowerControllerStatus<Dims>& step(const OutputVector& y) {
-    return tick(&y, InputVector::Zero(input_matrix_.cols()), false);
-  }
-
-  /// One control period with the leader's current input u_1 (used as configured by
-  /// leader_input_in_command / leader_input_in_estimator). A u_1 with a non-finite entry is
-  /// taken as unknown for this tick (status.leader_input_rejected), as in step(y); a non-finite
-  /// y is handled as in step(y).
-  const FollowerControllerStatus<Dims>& step(const OutputVector& y,
-                                             const InputVector& leader_input) {
-    return tick(&y, leader_input, true);
-  }
-
-  /// step(y) with the follower's own state x_2, from which the time headway (S1) acts (when
-  /// time_headway > 0; a non-finite x_2 leaves it out for this tick, and so does step()).
-  const FollowerControllerStatus<Dims>& stepWithOwnState(const OutputVector& y,
-                                                         const StateVector& own_state) {
-    return tick(&y, InputVector::Zero(input_matrix_.cols()), false, &own_state);
-  }
-
-  /// step(y, leader_input) with the follower's own state x_2, as stepWithOwnState(y, x_2).
-  const FollowerControllerStatus<Dims>& stepWithOwnState(const OutputVector& y,
-                                                         const StateVector& own_state,
-                                                         const InputVector& leader_input) {
-    return tick(&y, leader_input, true, &own_state);
-  }
-
-  /// One control period without a measurement: the fallback. The command brakes relative to
-  /// the leader from the estimate, which is predicted by the model alone and stays in Omega_1:
-  ///   u_2 = rate(sat(u_ff + K_f xi_hat)),   xi_hat' = Proj(A xi_hat + B (u_1m - u_2)),
-  /// with u_ff and u_1m the leader input as shared into the command and the estimator (0 when
-  /// unknown). For the default K_f = [0, k_v I] of a double integrator the predicted relative
-  /// velocity decays as e^{-k_v t} and the relative position comes to rest. Before any
-  /// measurement the estimate is the one the next step() would replace, zero. If u_ff + K_f
-  /// xi_hat overflows (huge gains), the command is u_ff alone, saturated and rate limited
-  /// (command_overflow).
-  const FollowerControllerStatus<Dims>& stepFallback() {
-    return tick(nullptr, InputVector::Zero(input_matrix_.cols()), false);
-  }
-
-  /// The fallback with the leader's current input u_1 (see stepFallback()); a u_1 with a
-  /// non-finite entry is taken as unknown (status.leader_input_rejected).
-  const FollowerControllerStatus<Dims>& stepFallback(const InputVector& leader_input) {
-    return tick(nullptr, leader_input, true);
+  const FollowerControllerStatus<Dims>& step(const StepInputs<Dims>& inputs) {
+    const bool leader_input_known = inputs.leader_input.has_value();
+    return tick(inputs.measurement ? &*inputs.measurement : nullptr,
+                leader_input_known ? *inputs.leader_input : InputVector::Zero(input_matrix_.cols()),
+                leader_input_known, inputs.own_state ? &*inputs.own_state : nullptr);
   }
 
   /// Forgets the estimate and the previous command (back to zero, a vehicle at rest); the next
@@ -147,9 +118,15 @@ class FollowerController {
   /// (m/s^2 for double integrators); zero before the first step and after reset().
   const InputVector& previousCommand() const { return rate_limiter_.previous(); }
 
-  /// Sets the previous command (moved into ||u|| <= acceleration_limit; zero if not finite), for
-  /// example to carry it over to a controller with a new design.
-  void setPreviousCommand(const InputVector& command) { rate_limiter_.setPrevious(command); }
+  /// Takes over the estimate (moved into this design's Omega_1, when @p other has one) and the
+  /// previous command (moved into ||u|| <= acceleration_limit) of @p other, a controller of the
+  /// same sizes with another design: the one way state is carried to a new design.
+  void adoptStateOf(const FollowerController& other) {
+    rate_limiter_.setPrevious(other.previousCommand());
+    if (other.initialized()) {
+      resetEstimate(other.estimate());
+    }
+  }
 
   const FollowerControllerStatus<Dims>& status() const { return status_; }
   const ControllerDesign& design() const { return design_; }
@@ -195,28 +172,21 @@ class FollowerController {
     initialized_ = true;
   }
 
-  /// The laws for the finite y; false, with nothing changed but the initialisation and
-  /// command_overflow set, if their command is not finite.
+  /// The laws for the finite y (AugmentedLaw); false, with nothing changed but the
+  /// initialisation and command_overflow set, if their command is not finite.
   bool advance(const OutputVector& y, const InputVector& leader_input, bool leader_input_known,
                const StateVector* own_state) {
-    const ControllerParameters& p = design_.parameters;
     if (!initialized_) {
       initialize(y);
     }
     const StateVector& estimate = estimator_.estimate();
-    const OutputVector estimated_output = output_matrix_ * estimate;
-
-    status_.baseline_command = baselineCommand<Dims>(baseline_gain_, y);  // (2)
-    status_.tracker_command = tracker_.command(y, estimated_output);      // (19)
-    const bool headway = headway_ && own_state != nullptr && own_state->allFinite();
-    status_.headway_command.setZero();
-    if (headway) {  // (S1)
-      status_.headway_command = headway_gain_ * (*own_state);
-    }
-    status_.command_saturated = augmentedCommand<Dims>(  // (10); an overflow stays not finite
-        status_.baseline_command, status_.tracker_command, status_.feedforward_command,
-        headway ? &status_.headway_command : nullptr, p.acceleration_limit, &status_.command);
-    if (!status_.command.allFinite()) {
+    law_.compose(y, output_matrix_ * estimate, status_.feedforward_command, own_state, &terms_);
+    status_.baseline_command = terms_.baseline;
+    status_.tracker_command = terms_.tracker;
+    status_.headway_command = terms_.headway;
+    status_.command_saturated = terms_.saturated;
+    status_.command = terms_.command;
+    if (!status_.command.allFinite()) {  // (10) overflowed
       status_.command_overflow = true;
       return false;
     }
@@ -226,17 +196,11 @@ class FollowerController {
     status_.fallback_command.setZero();
     status_.fallback = false;
     status_.command_rate_limited = rate_limiter_.limit(status_.command);
-    InputVector acting_augmentation = status_.tracker_command;  // u_a [+ K_h x_2], unless cut
-    if (status_.command_saturated || status_.command_rate_limited) {
-      acting_augmentation = actingAugmentation(status_.command, status_.baseline_command,
-                                               status_.feedforward_command);
-    } else if (headway) {
-      acting_augmentation += status_.headway_command;
-    }
-
-    const StateVector known_drift = knownDrift(leader_input, leader_input_known);
-    const EstimatorPeriodReport report = estimator_.advance(y, acting_augmentation, known_drift,
-                                                            design_.period, p.estimator_substeps);
+    const InputVector acting = law_.acting(terms_, status_.command, status_.feedforward_command,
+                                           status_.command_rate_limited);
+    const EstimatorPeriodReport report =
+        estimator_.advance(y, acting, knownDrift(leader_input, leader_input_known), design_.period,
+                           design_.parameters.estimator_substeps);
     status_.projection_active = report.projection_active;
     status_.boundary_correction = report.boundary_correction;
     status_.estimate_held = report.estimate_held;
@@ -274,12 +238,10 @@ class FollowerController {
     return status_;
   }
 
-  /// w = B (u_1 - u_ff) when the leader's input is shared into the estimator, else 0 (m/s).
+  /// w of (11) for this tick (AugmentedLaw::knownDrift()).
   StateVector knownDrift(const InputVector& leader_input, bool leader_input_known) const {
-    if (leader_input_known && design_.parameters.leader_input_in_estimator) {
-      return leaderInputDrift<Dims>(input_matrix_, leader_input, status_.feedforward_command);
-    }
-    return StateVector::Zero(input_matrix_.rows());
+    return law_.knownDrift(leader_input_known ? &leader_input : nullptr,
+                           status_.feedforward_command);
   }
 
   /// u_ff of this tick: the shared acceleration, shaped by (S2) when configured; 0 (and the
@@ -305,15 +267,13 @@ class FollowerController {
 
   ControllerDesign design_;
   CollisionFreeEstimator<Dims> estimator_;
-  CollisionFreeTracker<Dims> tracker_;
-  typename Dims::InputMatrix input_matrix_;                 // B
+  AugmentedLaw<Dims> law_;                   // (2), (19), (S1), (10) and what of them acts in (11)
+  AugmentedTerms<Dims> terms_;               // the latest tick's terms
+  typename Dims::InputMatrix input_matrix_;  // B
   typename Dims::OutputMatrix output_matrix_;               // C
-  typename Dims::FeedbackGainMatrix baseline_gain_;         // G
   typename Dims::ObserverGainMatrix output_pseudoinverse_;  // pinv(C)
   typename Dims::StateGainMatrix fallback_gain_;            // K_f
-  typename Dims::StateGainMatrix headway_gain_;             // K_h (S1)
   FeedforwardFilter<InputVector> feedforward_filter_;       // (S2)
-  bool headway_;                                            // time_headway > 0
   CommandRateLimiter<InputVector> rate_limiter_;            // jerk_limit, from u_2(k-1)
   FollowerControllerStatus<Dims> status_;
   bool initialized_ = false;

@@ -25,7 +25,7 @@ struct FollowerControllerStatus {
   bool projection_active = false;    ///< the projection acted during the period that follows
   double boundary_correction = 0.0;  ///< see EstimatorPeriodReport (m)
   /// step() got a measurement with a non-finite entry: it was treated as missing, and this tick
-  /// ran the fallback (stepFallback()) instead.
+  /// ran the fallback (a step without a measurement) instead.
   bool measurement_rejected = false;
   /// The leader's input u_1 had a non-finite entry: this tick took it as unknown.
   bool leader_input_rejected = false;

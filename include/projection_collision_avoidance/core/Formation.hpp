@@ -51,6 +51,11 @@ struct FormationMember {
   Eigen::VectorXd initial_state;
 };
 
+/// Follower @p index (1 .. spec.followers) of a formation: its name, target and slot d_i, as
+/// layoutFormation() lays them out (initial_state left empty).
+FormationMember formationSlot(const FormationSpec& spec, const Eigen::VectorXd& separation,
+                              int index);
+
 /// The followers of a formation in index order (every target precedes its follower).
 ///
 /// With d the scenario's separation, r_i = ceil(i / 2) and R(+-theta) the rotation of the

@@ -100,4 +100,16 @@ Input leaderAcceleration(const Input& leader_input, const Pseudoinverse& input_p
   return acceleration;
 }
 
+/// The one choice of the leader's acceleration a follower is told (m/s^2): a_1 = u_1 + pinv(B)
+/// u_d (leaderAcceleration()) when the disturbance is shared (@p disturbance_shared, the key
+/// controller.leader_information.disturbance) and known (@p disturbance not empty), else u_1.
+template <typename Input, typename Pseudoinverse, typename State>
+Input sharedLeaderAcceleration(bool disturbance_shared, const Input& leader_input,
+                               const Pseudoinverse& input_pseudoinverse, const State& disturbance) {
+  if (disturbance_shared && disturbance.size() > 0) {
+    return leaderAcceleration(leader_input, input_pseudoinverse, disturbance);
+  }
+  return leader_input;
+}
+
 }  // namespace projection_collision_avoidance

@@ -87,7 +87,7 @@ struct FollowerCycleOutput {
 /// slots the input side writes (measurement(), leader(), ownState()), decides the mode from their
 /// ages, runs one step of the controller and fills a FollowerCycleOutput. With a time headway
 /// (time_headway > 0) a step with a measurement uses the own state while it is younger than the
-/// measurement timeout (DynamicFollowerController::stepWithOwnState()), else leaves the headway
+/// measurement timeout (StepInputs::own_state), else leaves the headway
 /// out. Nothing in tick() or stepOnMeasurement() allocates, locks (except under the measurement
 /// trigger, whose steps run in the measurement's callback, and a tick waits for a step running
 /// there) or makes a system call, so that a real-time thread can run it.

@@ -12,11 +12,11 @@ class FollowerLoop;
 class MeasurementAdapter;
 class FollowerOutputs;
 class FollowerReconfigure;
-struct Scenario;
+struct FollowerConfiguration;
 
 /// ROS wrapper of DynamicFollowerController: translates messages and time, nothing else.
 ///
-/// The follower is member ~formation_index of the scenario's formation (layoutFormation()): it
+/// The follower is member ~formation_index of its formation (FollowerConfiguration::member()): it
 /// keeps the separation d_i of its slot to its target (the leader, or the follower ahead of it in
 /// a chain). Subscribes `relative_measurement` (RelativeMeasurement, x_target - x_i; with
 /// ~input odometry, position or tf a MeasurementAdapter makes it; doc/vehicles.md) and
@@ -84,7 +84,8 @@ class FollowerNode {
   FollowerNode& operator=(const FollowerNode&) = delete;
 
  private:
-  FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh, const Scenario& scenario);
+  FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh,
+               const FollowerConfiguration& configuration);
   /// Stops the loop, the outputs' thread, reconfiguration and the inputs, in that order.
   void stop();
 

@@ -3,12 +3,12 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "projection_collision_avoidance/core/AugmentedLaw.hpp"
 #include "projection_collision_avoidance/core/BallConstraint.hpp"
-#include "projection_collision_avoidance/core/CollisionFreeTracker.hpp"
+#include "projection_collision_avoidance/core/CollisionFreeEstimator.hpp"
 #include "projection_collision_avoidance/core/ControllerDesign.hpp"
 #include "projection_collision_avoidance/core/PaperLaws.hpp"
 #include "projection_collision_avoidance/core/ParameterError.hpp"
-#include "projection_collision_avoidance/core/ProjectionOperator.hpp"
 #include "projection_collision_avoidance/core/TypeDefs.hpp"
 
 namespace projection_collision_avoidance {
@@ -41,10 +41,11 @@ struct ContinuousLoopSignals {
 /// controller.leader_information (else 0), and Proj the Gamma^-1-weighted operator of the notes.
 /// sat() is the controller's: none unless controller.acceleration_limit is set. u_acts is the
 /// augmentation that acts: u_a, or u_2 - G y - u_ff while sat() acts (actingAugmentation()). The
-/// same equations as FollowerController, each from PaperLaws.hpp, except that u_2 and y are not
-/// held over a period. The controller's rate limit (controller.jerk_limit), a bound per control
-/// period, has no counterpart here and is refused, and so are the time headway (S1) and the
-/// shaped feed-forward (S2), which only the sampled loop models.
+/// same composition as FollowerController (AugmentedLaw, and the drift and projection of
+/// CollisionFreeEstimator), except that u_2 and y are not held over a period. The controller's rate
+/// limit (controller.jerk_limit), a bound per control period, has no counterpart here and is
+/// refused, and so are the time headway (S1) and the shaped feed-forward (S2), which only the
+/// sampled loop models.
 template <typename Dims>
 class ContinuousDynamics {
  public:
@@ -58,12 +59,10 @@ class ContinuousDynamics {
   ///        without a jerk_limit, time_headway or shaped feed-forward (ParameterError naming the
   ///        key otherwise)
   explicit ContinuousDynamics(const ControllerDesign& design)
-      : constraint_(design.xi_max, design.parameters.epsilon),
-        tracker_(design),
-        acceleration_limit_(design.parameters.acceleration_limit),
+      : law_(design),
+        estimator_(design),
         share_disturbance_(design.parameters.leader_disturbance_shared),
-        in_command_(design.parameters.leader_input_in_command),
-        in_estimator_(design.parameters.leader_input_in_estimator) {
+        in_command_(design.parameters.leader_input_in_command) {
     const AgentModel& model = design.parameters.model;
     if (!Dims::fits(model.stateDimension(), model.inputDimension(), model.outputDimension())) {
       throw std::invalid_argument("ContinuousDynamics: model sizes do not fit the dimensions");
@@ -85,10 +84,6 @@ class ContinuousDynamics {
     input_matrix_ = model.B;
     output_matrix_ = model.C;
     separation_ = design.parameters.separation;
-    baseline_gain_ = design.parameters.baseline_gain;
-    estimator_matrix_ = design.estimator_matrix;
-    observer_gain_ = design.parameters.estimator_gain;
-    gamma_inverse_ = design.gamma_inverse;
     input_pseudoinverse_ = design.input_pseudoinverse;
   }
 
@@ -102,63 +97,44 @@ class ContinuousDynamics {
                 State* derivative, Signals* signals = nullptr) const {
     const StateVector xi = z.leader - z.follower - separation_;
     const OutputVector y = output_matrix_ * xi;
-    const OutputVector estimated_output = output_matrix_ * z.estimate;
-    const InputVector tracker = tracker_.command(y, estimated_output);  // (19)
-    const InputVector acceleration =
-        share_disturbance_ ? leaderAcceleration(leader_input, input_pseudoinverse_, disturbance)
-                           : leader_input;  // a_1
+    const InputVector acceleration = sharedLeaderAcceleration(  // a_1
+        share_disturbance_, leader_input, input_pseudoinverse_, disturbance);
     InputVector feedforward = InputVector::Zero(input_matrix_.cols());
     if (in_command_) {
       feedforward = acceleration;
     }
-    const InputVector baseline = baselineCommand<Dims>(baseline_gain_, y);  // (2)
-    InputVector command;
-    const bool saturated =  // (10)
-        augmentedCommand<Dims>(baseline, tracker, feedforward, nullptr, acceleration_limit_,
-                               &command);
-
+    AugmentedTerms<Dims> terms;  // (2), (19), (10)
+    law_.compose(y, output_matrix_ * z.estimate, feedforward, nullptr, &terms);
     // (11) with the augmentation that acts, as the sampled controller's estimator integrates it
-    const InputVector acting =
-        saturated ? actingAugmentation(command, baseline, feedforward) : tracker;
-    StateVector known_drift = StateVector::Zero(input_matrix_.rows());
-    if (in_estimator_) {
-      known_drift = leaderInputDrift<Dims>(input_matrix_, acceleration, feedforward);
-    }
-    const StateVector drift = estimatorDrift<Dims>(
-        estimator_matrix_, z.estimate,
-        estimatorHeldInput<Dims>(input_matrix_, observer_gain_, y, acting, known_drift));
+    const InputVector acting = law_.acting(terms, terms.command, feedforward, false);
+    const StateVector held =
+        estimator_.heldInput(y, acting, law_.knownDrift(&acceleration, feedforward));
     bool active = false;
-    derivative->estimate = projectDrift(constraint_, z.estimate, drift, gamma_inverse_, &active);
+    derivative->estimate = estimator_.derivative(z.estimate, held, &active);  // (15)
     derivative->leader = state_matrix_ * z.leader + input_matrix_ * leader_input + disturbance;
-    derivative->follower = state_matrix_ * z.follower + input_matrix_ * command;
+    derivative->follower = state_matrix_ * z.follower + input_matrix_ * terms.command;
     if (signals != nullptr) {
       signals->relative_error = xi;
-      signals->baseline = baseline;
-      signals->tracker = tracker;
-      signals->command = command;
-      signals->constraint_value = constraint_.value(z.estimate);
+      signals->baseline = terms.baseline;
+      signals->tracker = terms.tracker;
+      signals->command = terms.command;
+      signals->constraint_value = estimator_.constraint().value(z.estimate);
       signals->projection_active = active;
     }
   }
 
   /// The constraint f of (13) on xi_hat.
-  const BallConstraint& constraint() const { return constraint_; }
+  const BallConstraint& constraint() const { return estimator_.constraint(); }
 
  private:
-  BallConstraint constraint_;
-  CollisionFreeTracker<Dims> tracker_;  // (19)
-  double acceleration_limit_;
+  AugmentedLaw<Dims> law_;                  // (2), (19), (10)
+  CollisionFreeEstimator<Dims> estimator_;  // the drift (11) and its projection (15); no state
   bool share_disturbance_;
   bool in_command_;
-  bool in_estimator_;
   typename Dims::StateMatrix state_matrix_;             // A
   typename Dims::InputMatrix input_matrix_;             // B
   typename Dims::OutputMatrix output_matrix_;           // C
   StateVector separation_;                              // d
-  typename Dims::FeedbackGainMatrix baseline_gain_;     // G
-  typename Dims::StateMatrix estimator_matrix_;         // A_c + L C
-  typename Dims::ObserverGainMatrix observer_gain_;     // L
-  typename Dims::StateMatrix gamma_inverse_;            // Gamma^-1
   typename Dims::StateGainMatrix input_pseudoinverse_;  // pinv(B)
 };
 

@@ -3,6 +3,7 @@
 #include <Eigen/Core>
 
 #include "projection_collision_avoidance/core/ControllerParameters.hpp"
+#include "projection_collision_avoidance/core/FollowerConfiguration.hpp"
 #include "projection_collision_avoidance/core/Formation.hpp"
 #include "projection_collision_avoidance/sim/SharedLink.hpp"
 #include "projection_collision_avoidance/sim/SignalProfile.hpp"
@@ -29,6 +30,9 @@ struct Scenario {
   /// "simulation.duration", "formation.*" or "controller.leader_information.link[.*]" (a link
   /// that carries nothing: neither command nor estimator shared).
   void validate() const;
+
+  /// The followers' part of the scenario: the controller and the formation.
+  FollowerConfiguration followerConfiguration() const { return {controller, formation}; }
 };
 
 }  // namespace projection_collision_avoidance

@@ -19,13 +19,14 @@
 namespace projection_collision_avoidance {
 
 FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
-    : FollowerNode(nh, private_nh, loadDoubleIntegratorScenario(private_nh)) {}
+    : FollowerNode(nh, private_nh,
+                   loadDoubleIntegratorScenario(private_nh).followerConfiguration()) {}
 
 FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh,
-                           const Scenario& scenario) {
+                           const FollowerConfiguration& configuration) {
   NodeOptionReader reader(private_nh);
-  const FormationMember member = memberOf(reader, scenario);
-  const ControllerParameters parameters = memberParameters(scenario.controller, member);
+  const FormationMember member = memberOf(reader, configuration);
+  const ControllerParameters parameters = memberParameters(configuration.controller, member);
   auto controller =
       std::make_unique<DynamicFollowerController>(ControllerDesign::create(parameters));
   const ControllerDesign& design = controller->design();

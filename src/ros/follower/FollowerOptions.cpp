@@ -101,18 +101,10 @@ PositionInputOptions readPositionOptions(NodeOptionReader& reader, MeasurementIn
 
 }  // namespace
 
-/// Member ~formation_index of the scenario's formation.
-FormationMember memberOf(NodeOptionReader& reader, const Scenario& scenario) {
+/// Member ~formation_index of the configured formation.
+FormationMember memberOf(NodeOptionReader& reader, const FollowerConfiguration& configuration) {
   const int index = reader.integer("formation_index", 1, 1, FormationSpec::kMaxFollowers);
-  if (index > scenario.formation.followers) {
-    throw ParameterError("~formation_index",
-                         "is " + std::to_string(index) + " but the formation has " +
-                             std::to_string(scenario.formation.followers) + " follower(s)");
-  }
-  const std::vector<FormationMember> members =
-      layoutFormation(scenario.formation, scenario.controller.separation,
-                      scenario.leader_initial_state, scenario.follower_initial_state);
-  return members[static_cast<std::size_t>(index - 1)];
+  return configuration.member(index, "~formation_index");
 }
 
 FollowerNodeOptions readFollowerOptions(NodeOptionReader& reader, const ControllerParameters& p,

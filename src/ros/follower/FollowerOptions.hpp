@@ -4,10 +4,10 @@
 #include <string>
 
 #include "projection_collision_avoidance/core/ControllerParameters.hpp"
+#include "projection_collision_avoidance/core/FollowerConfiguration.hpp"
 #include "projection_collision_avoidance/core/Formation.hpp"
 #include "projection_collision_avoidance/cycle/StampCorrection.hpp"
 #include "projection_collision_avoidance/ros/RosParameters.hpp"
-#include "projection_collision_avoidance/sim/Scenario.hpp"
 
 namespace projection_collision_avoidance {
 
@@ -112,9 +112,9 @@ struct FollowerNodeOptions {
   bool lock_memory = false;
 };
 
-/// Member ~formation_index of the scenario's formation (1 for the pair).
+/// Member ~formation_index of the configured formation (1 for the pair).
 /// @throws ParameterError naming ~formation_index
-FormationMember memberOf(NodeOptionReader& reader, const Scenario& scenario);
+FormationMember memberOf(NodeOptionReader& reader, const FollowerConfiguration& configuration);
 
 /// The follower node's options from its private namespace, each validated (the message names
 /// the key): ranges, ~input (and ~odometry/...), ~trigger, ~control_loop ("thread" refused under

@@ -1,7 +1,8 @@
 #pragma once
 
 /// @file
-/// Checks shared by the validators of the core (internal header).
+/// The checks of parameter values behind every validator (the core's and the simulation's):
+/// each throws ParameterError naming the key.
 
 #include <cmath>
 #include <string>

@@ -1,0 +1,32 @@
+#pragma once
+
+#include <optional>
+
+#include <Eigen/Core>
+
+#include "projection_collision_avoidance/core/TypeDefs.hpp"
+
+namespace projection_collision_avoidance {
+
+/// What the follower knows at one control tick, the argument of FollowerController::step(); an
+/// absent entry is unknown at this tick. Vectors of the controller's own sizes (fixed or
+/// bounded: no allocation).
+template <typename Dims>
+struct StepInputs {
+  /// y = C (x_1 - x_2 - d) (m, m/s for a double integrator); absent: the fallback runs.
+  std::optional<typename Dims::OutputVector> measurement{};
+  /// The target's acceleration a_1 (m/s^2), as shared with the follower; absent: unknown.
+  std::optional<typename Dims::InputVector> leader_input{};
+  /// The follower's own state x_2 (m, m/s), for the time headway (S1); absent: it does not act.
+  std::optional<typename Dims::StateVector> own_state{};
+};
+
+/// StepInputs of any sizes, the argument of DynamicFollowerController::step(): each entry a
+/// vector of the model's size (outputDimension(), inputDimension(), stateDimension()).
+struct DynamicStepInputs {
+  std::optional<Eigen::Ref<const Eigen::VectorXd>> measurement{};   ///< y (m, m/s)
+  std::optional<Eigen::Ref<const Eigen::VectorXd>> leader_input{};  ///< a_1 (m/s^2)
+  std::optional<Eigen::Ref<const Eigen::VectorXd>> own_state{};     ///< x_2 (m, m/s)
+};
+
+}  // namespace projection_collision_avoidance
