@@ -7,9 +7,9 @@
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
 
+#include "projection_collision_avoidance/cycle/InputGuard.hpp"
 #include "projection_collision_avoidance/ros/CountedPublisher.hpp"
 #include "projection_collision_avoidance/ros/InputAdmission.hpp"
-#include "projection_collision_avoidance/ros/InputGuard.hpp"
 #include "projection_collision_avoidance/sim/Scenario.hpp"
 
 namespace projection_collision_avoidance {
