@@ -54,7 +54,8 @@ class LeaderNode {
   /// s by which an odometry stamp may lie ahead of the leader's clock
   static constexpr double kMaxFutureStamp = 0.1;
   /// Restarted by the ticks when ROS time goes back (tick_time_).
-  InputTimeline odometry_timeline_{"leader/odom", {{"", kMaxFutureStamp, 0.0}, {}, false}};
+  InputTimeline odometry_timeline_{"leader/odom",
+                                   InputTimelineOptions{{"", kMaxFutureStamp, 0.0}, {}, false}};
   TimeJumpWatch tick_time_;  ///< ROS time of the ticks published
   bool started_ = false;
   ros::Time origin_;      ///< ROS time of scenario time 0
