@@ -17,12 +17,6 @@ void addSaturated(std::uint32_t* counter, std::uint32_t amount) {
                  : *counter + amount;
 }
 
-/// Age (s) at @p at_ns of an input stamped @p stamp_ns and received at @p receipt_ns: from the
-/// earlier of the two, so that a stamp ahead of the receiver's clock counts from its receipt.
-double ageOf(std::int64_t at_ns, std::int64_t stamp_ns, std::int64_t receipt_ns) {
-  return kNanosecond * static_cast<double>(at_ns - std::min(stamp_ns, receipt_ns));
-}
-
 }  // namespace
 
 std::uint32_t skippedPeriods(double gap, double period) {
@@ -99,14 +93,8 @@ void FollowerCycle::checkTimeline(std::int64_t now_ns) {
 bool FollowerCycle::tickLatched(std::int64_t now_ns, std::int64_t steady_ns, double delay,
                                 std::uint32_t skipped, FollowerCycleOutput* out) {
   out->stepped = false;
-  time_jump_ = 0.0;
   stall_ = 0.0;
-  if (have_latest_time_ && now_ns < latest_time_ns_) {
-    ++time_jumps_;
-    time_jump_ = kNanosecond * static_cast<double>(now_ns - latest_time_ns_);
-  }
-  latest_time_ns_ = now_ns;
-  have_latest_time_ = true;
+  time_.wentBack(now_ns);  // counted and reported (time_jump) by fillCounters()
   checkTimeline(now_ns);
 
   const double grace = 0.5 * settings_.measurement_timeout;
@@ -163,9 +151,9 @@ bool FollowerCycle::tickLatched(std::int64_t now_ns, std::int64_t steady_ns, dou
   }
   // Measurement trigger: the measurements run the steps while they are fresh; a tick only
   // brakes once they are stale.
-  const bool fresh =
-      have_measurement_ && ageOf(now_ns, measurement_.value().stamp_ns,
-                                 measurement_.value().receipt_ns) <= settings_.measurement_timeout;
+  const bool fresh = have_measurement_ &&
+                     inputAge(now_ns, measurement_.value().stamp_ns,
+                              measurement_.value().receipt_ns) <= settings_.measurement_timeout;
   if (ever_measured_ && !fresh) {
     return step(now_ns, now_ns, delay, out);
   }
@@ -190,13 +178,13 @@ bool FollowerCycle::step(std::int64_t now_ns, std::int64_t stamp_ns, double dela
                          FollowerCycleOutput* out) {
   FollowerInputAges ages;
   ages.have_measurement = ever_measured_;
-  ages.measurement_age = have_measurement_ ? ageOf(stamp_ns, measurement_.value().stamp_ns,
-                                                   measurement_.value().receipt_ns)
-                                           : std::numeric_limits<double>::infinity();
+  ages.measurement_age = have_measurement_ ? inputAge(stamp_ns, measurement_.value().stamp_ns,
+                                                      measurement_.value().receipt_ns)
+                                           : kNoInputAge;
   ages.have_leader = ever_led_;
   ages.leader_age = have_leader_
-                        ? ageOf(stamp_ns, leader_.value().stamp_ns, leader_.value().receipt_ns)
-                        : std::numeric_limits<double>::infinity();
+                        ? inputAge(stamp_ns, leader_.value().stamp_ns, leader_.value().receipt_ns)
+                        : kNoInputAge;
   mode_ = selectFollowerMode(
       ages, FollowerTimeouts{settings_.measurement_timeout, settings_.leader_timeout});
   out->stepped = false;
@@ -222,7 +210,7 @@ bool FollowerCycle::step(std::int64_t now_ns, std::int64_t stamp_ns, double dela
   const OwnStateSample& own = own_state_.value();
   out->own_state_fresh =
       design.parameters.time_headway > 0.0 && have_own_state_ &&
-      ageOf(stamp_ns, own.stamp_ns, own.receipt_ns) <= settings_.measurement_timeout;
+      inputAge(stamp_ns, own.stamp_ns, own.receipt_ns) <= settings_.measurement_timeout;
   DynamicStepInputs inputs;  // without a measurement the step runs the fallback
   if (mode_ != FollowerMode::kMeasurementLost) {
     y_.noalias() = design.parameters.model.C * out->xi;
@@ -251,8 +239,8 @@ void FollowerCycle::fillCounters(std::int64_t now_ns, FollowerCycleOutput* out) 
   out->missed_periods = missed_periods_;
   out->late_periods = late_periods_;
   out->tick_delay = tick_delay_;
-  out->time_jumps = time_jumps_;
-  out->time_jump = time_jump_;
+  out->time_jumps = time_.jumps();
+  out->time_jump = time_.jump();
   out->stall = stall_;
   if (!out->stepped) {
     out->steps = steps_;

@@ -47,28 +47,28 @@ LeaderNode::LeaderNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
 
 void LeaderNode::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
   const std::lock_guard<std::mutex> lock(mutex_);
-  admitGuarded(odometry_guard_, name_, [&] {
+  admitGuarded(odometry_timeline_, name_, [&] {
     const ros::Time now = ros::Time::now();
-    if (!checkHeader(odometry_guard_, msg->header, now)) {
+    if (!checkHeader(odometry_timeline_, msg->header, now)) {
       return;
     }
     if (msg->child_frame_id != options_.leader_frame) {
-      odometry_guard_.reject(Rejection::kContent,
-                             "child_frame_id '" +
-                                 boundedText(msg->child_frame_id, InputGuard::kMaxQuotedLength) +
-                                 "', expected '" + options_.leader_frame + "'");
+      odometry_timeline_.reject(Rejection::kContent,
+                                "child_frame_id '" +
+                                    boundedText(msg->child_frame_id, InputGuard::kMaxQuotedLength) +
+                                    "', expected '" + options_.leader_frame + "'");
       return;
     }
     Eigen::VectorXd state;
     if (!stateFromOdometryMsg(*msg, axes_, &state)) {
-      odometry_guard_.reject(Rejection::kContent, "non-finite position or velocity");
+      odometry_timeline_.reject(Rejection::kContent, "non-finite position or velocity");
       return;
     }
     odometry_ = *msg;
     state_ = state;
     have_odometry_ = true;
     odometry_fresh_ = true;
-    odometry_guard_.accept(nanosecondsOf(msg->header.stamp), nanosecondsOf(now));
+    odometry_timeline_.accept();
   });
 }
 
@@ -81,12 +81,12 @@ void LeaderNode::onTick(const ros::TimerEvent& event) {
   if (stamp.isZero() || (started_ && stamp == last_stamp_)) {
     return;
   }
-  if (started_ && stamp < last_stamp_) {
+  if (wentBack(tick_time_, stamp)) {
     // A restarted /clock, say: follow it, and forget the odometry of the old time line.
     ROS_WARN_STREAM(name_ << ": ROS time went back from " << last_stamp_.toSec() << " s to "
                           << stamp.toSec() << " s");
     have_odometry_ = false;
-    odometry_guard_.restartTimeline();
+    odometry_timeline_.restart();
   }
   last_stamp_ = stamp;
   if (!started_) {

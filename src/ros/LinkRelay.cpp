@@ -73,7 +73,7 @@ void LinkRelay::onTick(const ros::TimerEvent& /*event*/) {
 }
 
 void LinkRelay::releaseDue(const ros::Time& now) {
-  if (clock_.wentBack(now)) {
+  if (wentBack(clock_, now)) {
     ROS_WARN_STREAM(name_ << ": ROS time went back: " << in_flight_.size()
                           << " message(s) in flight dropped");
     in_flight_.clear();

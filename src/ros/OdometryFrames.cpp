@@ -4,7 +4,7 @@
 #include <tf2/exceptions.h>
 #include <tf2_eigen/tf2_eigen.h>
 
-#include "projection_collision_avoidance/ros/InputGuard.hpp"
+#include "projection_collision_avoidance/cycle/InputGuard.hpp"
 #include "projection_collision_avoidance/ros/MessageConversions.hpp"
 
 namespace projection_collision_avoidance {

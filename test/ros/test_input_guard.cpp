@@ -1,4 +1,5 @@
-/// The admission of input messages (InputGuard, admitGuarded, ClockWatch): no master needed.
+/// The admission of input messages (InputGuard, admitGuarded, TimeJumpWatch and InputTimeline
+/// on ROS time): no master needed.
 
 #include <cmath>
 #include <cstdint>
@@ -8,8 +9,8 @@
 
 #include <gtest/gtest.h>
 
+#include "projection_collision_avoidance/cycle/InputGuard.hpp"
 #include "projection_collision_avoidance/ros/InputAdmission.hpp"
-#include "projection_collision_avoidance/ros/InputGuard.hpp"
 
 namespace projection_collision_avoidance {
 namespace {
@@ -139,18 +140,40 @@ TEST(AdmitGuarded, AMessageThatCannotBeJudgedIsCountedNotFatal) {
   EXPECT_EQ(guard.rejected(), 2U);
 }
 
-TEST(ClockWatch, ReportsEachJumpBackOnce) {
-  ClockWatch watch;
-  EXPECT_FALSE(watch.wentBack(ros::Time(10.0)));
-  EXPECT_FALSE(watch.wentBack(ros::Time(10.0)));  // standing still is no jump
-  EXPECT_FALSE(watch.wentBack(ros::Time(11.0)));
-  EXPECT_TRUE(watch.wentBack(ros::Time(2.0)));
+TEST(TimeJumpWatch, ReportsEachJumpBackOfRosTimeOnce) {
+  TimeJumpWatch watch;
+  EXPECT_FALSE(wentBack(watch, ros::Time(10.0)));
+  EXPECT_FALSE(wentBack(watch, ros::Time(10.0)));  // standing still is no jump
+  EXPECT_FALSE(wentBack(watch, ros::Time(11.0)));
+  EXPECT_TRUE(wentBack(watch, ros::Time(2.0)));
   EXPECT_DOUBLE_EQ(watch.jump(), -9.0);
-  EXPECT_FALSE(watch.wentBack(ros::Time(2.5)));
-  EXPECT_TRUE(watch.wentBack(ros::Time(0, 1)));
+  EXPECT_FALSE(wentBack(watch, ros::Time(2.5)));
+  EXPECT_TRUE(wentBack(watch, ros::Time(0, 1)));
   EXPECT_EQ(watch.jumps(), 2U);
   EXPECT_DOUBLE_EQ(secondsBetween(ros::Time(4294967295U, 999999999U), ros::Time(0, 1)),
                    4294967295.999999998);
+}
+
+TEST(InputTimeline, JudgesRosHeadersAndCountsWhatCannotBeJudged) {
+  InputTimelineOptions options;
+  options.limits = {"world", 0.05, 0.5};
+  InputTimeline timeline("topic", options);
+  std_msgs::Header header;
+  header.frame_id = "world";
+  header.stamp = ros::Time(100.0);
+  admitGuarded(timeline, "test", [&] {
+    ASSERT_TRUE(checkHeader(timeline, header, ros::Time(100.01)));
+    timeline.accept();
+  });
+  EXPECT_NEAR(timeline.age(nanosecondsOf(ros::Time(100.02))), 0.02, 1e-9);
+  admitGuarded(timeline, "test", [] { throw std::runtime_error("no"); });
+  EXPECT_EQ(timeline.rejected(), 1U);
+  EXPECT_EQ(timeline.guard().lastKind(), Rejection::kUnjudgeable);
+  // ROS time went back: the timeline restarts, the input has no age until the next one.
+  header.stamp = ros::Time(5.0);
+  EXPECT_TRUE(checkHeader(timeline, header, ros::Time(5.0)));
+  EXPECT_EQ(timeline.age(nanosecondsOf(ros::Time(5.0))), kNoInputAge);
+  EXPECT_EQ(timeline.jumps().jumps(), 1U);
 }
 
 }  // namespace

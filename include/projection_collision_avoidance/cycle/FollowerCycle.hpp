@@ -9,6 +9,8 @@
 #include "projection_collision_avoidance/core/DynamicFollowerController.hpp"
 #include "projection_collision_avoidance/core/FollowerMode.hpp"
 #include "projection_collision_avoidance/core/TypeDefs.hpp"
+#include "projection_collision_avoidance/cycle/InputTimeline.hpp"
+#include "projection_collision_avoidance/cycle/TimeJumpWatch.hpp"
 #include "projection_collision_avoidance/rt/LatestValue.hpp"
 
 namespace projection_collision_avoidance {
@@ -94,7 +96,8 @@ struct FollowerCycleOutput {
 ///
 /// Time: every call reads the ROS time `now_ns` after it has latched the inputs. An input is valid
 /// while it was received at or before now (after a jump back of ROS time, those of the old timeline
-/// are not, so the follower brakes until new ones arrive); its age counts from min(stamp, receipt).
+/// are not, so the follower brakes until new ones arrive); its age is inputAge(), from
+/// min(stamp, receipt), as InputTimeline::age() reports it, and +inf (kNoInputAge) when none.
 /// A stalled process (a tick more than half the measurement timeout late on ROS time, or that long
 /// after the tick before on the steady clock) starts a wait: ticks are skipped and counted as
 /// missed until a measurement is accepted, or half the timeout has passed on the steady clock
@@ -215,10 +218,7 @@ class FollowerCycle {
   bool have_own_state_ = false;
   bool ever_own_state_ = false;
 
-  bool have_latest_time_ = false;
-  std::int64_t latest_time_ns_ = 0;  ///< latest ROS time seen (jumps back)
-  std::uint32_t time_jumps_ = 0;
-  double time_jump_ = 0.0;
+  TimeJumpWatch time_;                     ///< jumps back of ROS time at the ticks
   bool resuming_ = false;                  ///< waiting for input after a stall
   std::int64_t resumed_at_steady_ns_ = 0;  ///< the wait's start, or the latest future refusal
   std::int64_t stall_began_steady_ns_ = 0;

@@ -10,8 +10,9 @@
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
 
+#include "projection_collision_avoidance/cycle/InputGuard.hpp"
+#include "projection_collision_avoidance/cycle/InputTimeline.hpp"
 #include "projection_collision_avoidance/ros/InputAdmission.hpp"
-#include "projection_collision_avoidance/ros/InputGuard.hpp"
 #include "projection_collision_avoidance/vehicle/CommandConverter.hpp"
 #include "projection_collision_avoidance/vehicle/OutputWatchdog.hpp"
 
@@ -35,7 +36,8 @@ struct CommandAdapterOptions;
 /// stands still) every output gets its stop (zero velocity, zero v and ω, a braking
 /// acceleration), again at every check until commands return. Commands that are non-finite, act
 /// on an axis the model lacks, or are stamped 0, in the future or not after the last one, are
-/// refused and counted (InputGuard); so are non-finite odometry messages. No input ends the node.
+/// refused and counted (InputTimeline); so are non-finite odometry messages. No input ends the
+/// node.
 class CommandAdapter {
  public:
   /// @throws ParameterError naming the key of an invalid option
@@ -56,10 +58,8 @@ class CommandAdapter {
   std::mutex mutex_;  ///< the callbacks may run at once (nodelets)
   CommandConverter converter_;
   OutputWatchdog watchdog_;
-  InputGuard command_guard_;
-  ClockWatch command_clock_;
-  InputGuard odometry_guard_;
-  ClockWatch odometry_clock_;
+  InputTimeline command_timeline_;
+  InputTimeline odometry_timeline_;
   std::string world_frame_;  ///< ~world_frame, or the own odometry's header.frame_id
   std::string base_frame_;   ///< ~base_frame, or the own odometry's child_frame_id
   Eigen::VectorXd acceleration_;

@@ -32,10 +32,10 @@ struct FollowerConfiguration;
 /// (visualization_msgs/MarkerArray in the follower's frame, id = formation index) and
 /// diagnostics. Messages that are non-finite, of the wrong size, in the wrong frame, stamped 0,
 /// in the future, stale on arrival, or not after the last accepted one are refused and counted
-/// (InputGuard), and so is a message whose judging throws: no input ends the node. When ROS time
-/// goes back (ClockWatch), the inputs of the old timeline are forgotten and the follower brakes
-/// until fresh measurements arrive. A tick that runs more than half ~measurement_timeout late
-/// (the process itself was stalled) is skipped, and so are the ticks after it until a
+/// (InputTimeline), and so is a message whose judging throws: no input ends the node. When ROS
+/// time goes back (TimeJumpWatch), the inputs of the old timeline are forgotten and the follower
+/// brakes until fresh measurements arrive. A tick that runs more than half ~measurement_timeout
+/// late (the process itself was stalled) is skipped, and so are the ticks after it until a
 /// measurement arrives or half ~measurement_timeout has passed (all counted as missed): the
 /// input sent while the process stood still decides the next step, not its absence.
 /// dynamic_reconfigure changes the tracker switch, alpha, epsilon and the tracker gain (frequency

@@ -8,7 +8,9 @@
 #include <ros/time.h>
 #include <std_msgs/Header.h>
 
-#include "projection_collision_avoidance/ros/InputGuard.hpp"
+#include "projection_collision_avoidance/cycle/InputGuard.hpp"
+#include "projection_collision_avoidance/cycle/InputTimeline.hpp"
+#include "projection_collision_avoidance/cycle/TimeJumpWatch.hpp"
 
 namespace projection_collision_avoidance {
 
@@ -60,43 +62,35 @@ void admitGuarded(InputGuard& guard, const std::string& node, Judge&& judge) noe
   }
 }
 
-/// Watches ROS time for jumps back (a restarted simulator's /clock, a looping bag, an NTP step
-/// on wall time): wentBack() is true once per jump, the first time a time earlier than the
-/// latest one seen is passed.
-class ClockWatch {
- public:
-  /// Records @p now; true when it lies before the latest time seen (the jump's size: jump()).
-  bool wentBack(const ros::Time& now) {
-    const std::int64_t now_ns = nanosecondsOf(now);
-    const bool back = have_latest_ && now_ns < latest_ns_;
-    jump_ = back ? 1e-9 * static_cast<double>(now_ns - latest_ns_) : 0.0;
-    latest_ns_ = now_ns;
-    have_latest_ = true;
-    if (back) {
-      ++jumps_;
+/// admitGuarded() for an InputTimeline: refusals and log lines go through it.
+template <typename Judge>
+void admitGuarded(InputTimeline& timeline, const std::string& node, Judge&& judge) noexcept {
+  try {
+    try {
+      judge();
+    } catch (const std::exception& error) {
+      timeline.reject(Rejection::kUnjudgeable, error.what());
+    } catch (...) {
+      timeline.reject(Rejection::kUnjudgeable, "unknown exception");
     }
-    return back;
+    const std::string line = timeline.takeLogLine();
+    if (!line.empty()) {
+      ROS_WARN_STREAM(node << ": " << line);
+    }
+  } catch (...) {  // out of memory while counting: drop the message, keep the node
   }
-  /// Size (s, negative) of the last jump back reported by wentBack().
-  double jump() const { return jump_; }
-  /// Jumps back seen since start.
-  std::uint32_t jumps() const { return jumps_; }
+}
 
- private:
-  bool have_latest_ = false;
-  std::int64_t latest_ns_ = 0;
-  double jump_ = 0.0;
-  std::uint32_t jumps_ = 0;
-};
+/// InputTimeline::checkHeader() for a ROS header received at ROS time @p now (a jump back of
+/// ROS time restarts the timeline, the stamp is put on this clock, the header judged).
+inline bool checkHeader(InputTimeline& timeline, const std_msgs::Header& header,
+                        const ros::Time& now) {
+  return timeline.checkHeader(header.frame_id, nanosecondsOf(header.stamp), nanosecondsOf(now));
+}
 
-/// Notes a jump back of ROS time at @p now on @p clock (restarting @p guard's timeline), then
-/// judges @p header (checkHeader()).
-inline bool checkHeaderOnTimeline(InputGuard& guard, ClockWatch& clock,
-                                  const std_msgs::Header& header, const ros::Time& now) {
-  if (clock.wentBack(now)) {
-    guard.restartTimeline();
-  }
-  return checkHeader(guard, header, now);
+/// TimeJumpWatch::wentBack() at ROS time @p now.
+inline bool wentBack(TimeJumpWatch& watch, const ros::Time& now) {
+  return watch.wentBack(nanosecondsOf(now));
 }
 
 }  // namespace projection_collision_avoidance

@@ -7,9 +7,11 @@
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
 
+#include "projection_collision_avoidance/cycle/InputGuard.hpp"
+#include "projection_collision_avoidance/cycle/InputTimeline.hpp"
+#include "projection_collision_avoidance/cycle/TimeJumpWatch.hpp"
 #include "projection_collision_avoidance/ros/CountedPublisher.hpp"
 #include "projection_collision_avoidance/ros/InputAdmission.hpp"
-#include "projection_collision_avoidance/ros/InputGuard.hpp"
 #include "projection_collision_avoidance/sim/Scenario.hpp"
 
 namespace projection_collision_avoidance {
@@ -51,7 +53,10 @@ class LeaderNode {
   bool odometry_fresh_ = false;  ///< an odometry not broadcast yet
   /// s by which an odometry stamp may lie ahead of the leader's clock
   static constexpr double kMaxFutureStamp = 0.1;
-  InputGuard odometry_guard_{"leader/odom", {"", kMaxFutureStamp, 0.0}};
+  /// Restarted by the ticks when ROS time goes back (tick_time_).
+  InputTimeline odometry_timeline_{"leader/odom",
+                                   InputTimelineOptions{{"", kMaxFutureStamp, 0.0}, {}, false}};
+  TimeJumpWatch tick_time_;  ///< ROS time of the ticks published
   bool started_ = false;
   ros::Time origin_;      ///< ROS time of scenario time 0
   ros::Time last_stamp_;  ///< of the last tick published

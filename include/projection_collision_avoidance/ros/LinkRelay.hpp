@@ -50,7 +50,7 @@ class LinkRelay {
   int delay_periods_ = 0;  ///< D
   std::mutex mutex_;
   std::deque<std::pair<double, LeaderBroadcast::ConstPtr>> in_flight_;  ///< (release s, message)
-  ClockWatch clock_;
+  TimeJumpWatch clock_;
   std::uint64_t received_ = 0;
   std::uint64_t lost_ = 0;
   std::uint64_t passed_ = 0;

@@ -43,8 +43,8 @@ CommandAdapter::CommandAdapter(ros::NodeHandle nh, ros::NodeHandle private_nh)
       options_(readOptions(private_nh)),
       converter_(options_->converter),
       watchdog_(options_->command_timeout),
-      command_guard_("command", {"", 0.1, options_->command_timeout}),
-      odometry_guard_("odom", {"", 0.1, 0.0}),
+      command_timeline_("command", InputGuardLimits{"", 0.1, options_->command_timeout}),
+      odometry_timeline_("odom", InputGuardLimits{"", 0.1, 0.0}),
       world_frame_(options_->world_frame),
       base_frame_(options_->base_frame),
       acceleration_(Eigen::VectorXd::Zero(options_->converter.axes)) {
@@ -80,9 +80,9 @@ CommandAdapter::~CommandAdapter() {
 
 void CommandAdapter::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
   const std::lock_guard<std::mutex> lock(mutex_);
-  admitGuarded(odometry_guard_, name_, [&] {
+  admitGuarded(odometry_timeline_, name_, [&] {
     const ros::Time now = ros::Time::now();
-    if (!checkHeaderOnTimeline(odometry_guard_, odometry_clock_, msg->header, now)) {
+    if (!checkHeader(odometry_timeline_, msg->header, now)) {
       return;
     }
     // The heading in the world frame of the commands (tf2 when the odometry's frame differs).
@@ -91,15 +91,15 @@ void CommandAdapter::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
     if (!odometryInFrame(*msg, options_->world_frame,
                          options_->converter.odometry_twist_frame == TwistFrame::kBody, tf_buffer_,
                          0.0, &sample, &why)) {
-      odometry_guard_.reject(Rejection::kContent, why);
+      odometry_timeline_.reject(Rejection::kContent, why);
       return;
     }
     if (!converter_.observe(sample)) {
-      odometry_guard_.reject(Rejection::kContent,
-                             "non-finite field or an orientation that is not a unit quaternion");
+      odometry_timeline_.reject(Rejection::kContent,
+                                "non-finite field or an orientation that is not a unit quaternion");
       return;
     }
-    odometry_guard_.accept(nanosecondsOf(msg->header.stamp), nanosecondsOf(now));
+    odometry_timeline_.accept();
     if (options_->base_frame.empty()) {
       base_frame_ = msg->child_frame_id;
     }
@@ -109,21 +109,20 @@ void CommandAdapter::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
 
 void CommandAdapter::onCommand(const geometry_msgs::AccelStamped::ConstPtr& msg) {
   const std::lock_guard<std::mutex> lock(mutex_);
-  admitGuarded(command_guard_, name_, [&] {
+  admitGuarded(command_timeline_, name_, [&] {
     const ros::Time now = ros::Time::now();
-    if (command_clock_.wentBack(now)) {
-      command_guard_.restartTimeline();
+    if (command_timeline_.noteTime(nanosecondsOf(now))) {  // the timeline restarts
       watchdog_.reset();
     }
-    if (!checkHeader(command_guard_, msg->header, now)) {
+    if (!checkHeader(command_timeline_, msg->header, now)) {
       return;
     }
     std::string why;
     if (!commandFromAccelMsg(*msg, options_->converter.axes, &acceleration_, &why)) {
-      command_guard_.reject(Rejection::kContent, why);
+      command_timeline_.reject(Rejection::kContent, why);
       return;
     }
-    command_guard_.accept(nanosecondsOf(msg->header.stamp), nanosecondsOf(now));
+    command_timeline_.accept();
     const ConvertedCommand& command = converter_.convert(acceleration_, now.toSec());
     if (!command.heading_known) {
       ROS_WARN_STREAM_THROTTLE(5.0, name_ << ": no fresh own odometry (odom) for the heading: "

@@ -14,10 +14,10 @@
 #include "projection_collision_avoidance/RelativeMeasurement.h"
 #include "projection_collision_avoidance/core/ControllerDesign.hpp"
 #include "projection_collision_avoidance/cycle/FollowerCycle.hpp"
-#include "projection_collision_avoidance/cycle/StampCorrection.hpp"
+#include "projection_collision_avoidance/cycle/InputGuard.hpp"
+#include "projection_collision_avoidance/cycle/InputTimeline.hpp"
 #include "projection_collision_avoidance/ros/InlineCallbackQueue.hpp"
 #include "projection_collision_avoidance/ros/InputAdmission.hpp"
-#include "projection_collision_avoidance/ros/InputGuard.hpp"
 
 #include "follower/FollowerOptions.hpp"
 #include "follower/MeasurementAdapter.hpp"
@@ -32,9 +32,9 @@ struct FollowerInputStats {
   std::uint64_t rejected_odometry = 0;
   std::string measurement_rejection;  ///< the latest, "" once one was accepted after it
   std::string leader_rejection;
-  double measurement_age =
-      -1.0;                  ///< s, of the last accepted measurement; -1: none on this timeline
-  double leader_age = -1.0;  ///< s, of the last accepted leader broadcast; -1: none
+  /// s, of the last accepted measurement (InputTimeline::age()); +inf: none on this timeline
+  double measurement_age = kNoInputAge;
+  double leader_age = kNoInputAge;   ///< s, of the last accepted leader broadcast; +inf: none
   std::uint64_t rejected_input = 0;  ///< messages the input adapter refused (~input not
                                      ///< relative_measurement)
   double input_skew = -1.0;          ///< s, the adapter's latest skew; -1: none
@@ -48,7 +48,7 @@ struct FollowerInputStats {
 /// other inputs hand their measurements to admitMeasurement()), `leader_broadcast` and, with a time
 /// headway (time_headway > 0), `odom` (nav_msgs/Odometry: its own state; frame ~odom_frame,
 /// refused once older than ~measurement_timeout on arrival), judges each message with its
-/// InputGuard (doc/boundary.md) on the subscriber's thread, and writes what it accepts into the
+/// InputTimeline (doc/boundary.md) on the subscriber's thread, and writes what it accepts into the
 /// control cycle's lock-free slots. With ~trigger measurement, each accepted measurement runs
 /// the cycle's step at once and hands its output to @p on_step. Nothing a message carries can
 /// end the node (admitGuarded()). The subscriptions start with start().
@@ -85,25 +85,6 @@ class FollowerInputs {
   void onMeasurement(const RelativeMeasurement::ConstPtr& msg);
   void onLeaderBroadcast(const LeaderBroadcast::ConstPtr& msg);
   void onOdometry(const nav_msgs::Odometry::ConstPtr& msg);
-  /// One input's last accepted message, for its age: effective stamp min(stamp, receipt) and
-  /// receipt (ns); kNone when there is none on this timeline.
-  struct Heard {
-    static constexpr std::int64_t kNone = -1;
-    std::atomic<std::int64_t> effective_ns{kNone};
-    std::atomic<std::int64_t> receipt_ns{kNone};
-    /// A message stamped @p stamp_ns accepted at @p now_ns.
-    void note(std::int64_t stamp_ns, std::int64_t now_ns);
-    /// Age (s) at @p now_ns; -1 when none, or received after @p now_ns (an older timeline).
-    double ageAt(std::int64_t now_ns) const;
-  };
-  /// Notes a jump back of ROS time on this input's side (restarting @p guard's timeline,
-  /// forgetting @p heard and what @p correction learnt), then judges @p header at @p now on the
-  /// sender's clock: now − the offset @p correction adds to the stamp (~clock_skew/policy),
-  /// returned in @p offset_ns.
-  static bool admitHeader(InputGuard& guard, ClockWatch& clock, Heard& heard,
-                          StampCorrection& correction, const std_msgs::Header& header,
-                          const ros::Time& now, std::int64_t* offset_ns);
-
   std::string name_;
   FollowerNodeOptions options_;
   ControllerDesign design_;  ///< the start's: what the inputs read of it (period, time headway,
@@ -112,32 +93,20 @@ class FollowerInputs {
   FollowerCycle* cycle_;
   StepSink on_step_;
 
-  // Subscriber threads only (one at a time per input: roscpp serialises a subscription).
-  InputGuard measurement_guard_;
-  ClockWatch measurement_clock_;
-  StampCorrection measurement_correction_;
-  std::int64_t last_corrected_ns_ = 0;  ///< the latest accepted measurement's corrected stamp
+  // Subscriber threads only (one at a time per input: roscpp serialises a subscription), except
+  // what each timeline lets other threads read (its age, skew and refusal count).
+  InputTimeline measurement_timeline_;
   MeasurementSample measurement_;
   Eigen::VectorXd relative_state_;
   FollowerCycleOutput trigger_output_;
-  InputGuard leader_guard_;
-  ClockWatch leader_clock_;
-  StampCorrection leader_correction_;
+  InputTimeline leader_timeline_;
   LeaderSample leader_;
-  InputGuard odometry_guard_;
-  ClockWatch odometry_clock_;
+  InputTimeline odometry_timeline_;
   OwnStateSample own_state_;
   Eigen::VectorXd odometry_state_;
 
   // Read by other threads.
   std::atomic<const MeasurementAdapter*> adapter_{nullptr};
-  std::atomic<std::uint64_t> rejected_measurements_{0};
-  std::atomic<std::uint64_t> rejected_leader_broadcasts_{0};
-  std::atomic<std::uint64_t> rejected_odometry_{0};
-  Heard measurement_heard_;
-  Heard leader_heard_;
-  std::atomic<double> measurement_skew_{std::numeric_limits<double>::quiet_NaN()};
-  std::atomic<double> leader_skew_{std::numeric_limits<double>::quiet_NaN()};
   std::atomic<double> clock_offset_{0.0};
   mutable std::mutex reasons_mutex_;
   std::string measurement_rejection_;

@@ -73,7 +73,7 @@ FollowerLoop::~FollowerLoop() {
 void FollowerLoop::onTimer(const ros::TimerEvent& event) {
   try {
     const ros::Time now = ros::Time::now();
-    if (clock_.wentBack(now)) {
+    if (wentBack(clock_, now)) {
       have_last_expected_ = false;  // the expected times of the old timeline do not count
     }
     const double delay = secondsBetween(event.current_real, event.current_expected);

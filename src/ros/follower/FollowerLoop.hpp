@@ -65,7 +65,7 @@ class FollowerLoop {
   double period_;
   FollowerCycleOutput timer_output_;   ///< the timer thread's
   FollowerCycleOutput thread_output_;  ///< the control thread's
-  ClockWatch clock_;                   ///< jumps back of ROS time at the timer's ticks
+  TimeJumpWatch clock_;                ///< jumps back of ROS time at the timer's ticks
   ros::Time last_expected_;
   bool have_last_expected_ = false;
   ros::CallbackQueue queue_;

@@ -32,12 +32,12 @@ OdometryInput::OdometryInput(std::string node_name, const FollowerNodeOptions& o
       sink_(std::move(sink)),
       relative_(alignmentOptions(options.odometry, axes)),
       world_frame_(options.measurement_frame),
+      // A message older than the measurement timeout on arrival could only be stale.
+      self_("odom", InputGuardLimits{options.odom_frame, options.max_future_stamp,
+                                     options.measurement_timeout}),
+      target_("target_odom",
+              InputGuardLimits{"", options.max_future_stamp, options.measurement_timeout}),
       skew_(std::numeric_limits<double>::quiet_NaN()) {
-  // A message older than the measurement timeout on arrival could only be stale.
-  self_.guard = InputGuard(
-      "odom", {options.odom_frame, options.max_future_stamp, options.measurement_timeout});
-  target_.guard =
-      InputGuard("target_odom", {"", options.max_future_stamp, options.measurement_timeout});
   pair_guard_ = InputGuard("odometry pair", {"", options.max_future_stamp, 3600.0});
 }
 
@@ -54,15 +54,16 @@ void OdometryInput::start(ros::NodeHandle nh) {
 
 void OdometryInput::onOdometry(Side* side, const nav_msgs::Odometry::ConstPtr& msg) {
   const std::lock_guard<std::mutex> lock(mutex_);
-  const std::uint64_t before = side->guard.rejected();
-  admitGuarded(side->guard, name_, [&] {
+  InputTimeline& timeline = side->timeline;
+  const std::uint64_t before = timeline.rejected();
+  admitGuarded(timeline, name_, [&] {
     const ros::Time now = ros::Time::now();
-    if (side->clock.wentBack(now)) {  // both sides forget the old timeline
-      self_.guard.restartTimeline();
-      target_.guard.restartTimeline();
+    if (timeline.noteTime(nanosecondsOf(now))) {  // both sides forget the old timeline
+      self_.timeline.restart();
+      target_.timeline.restart();
       self_.have = target_.have = false;
     }
-    if (!checkHeader(side->guard, msg->header, now)) {
+    if (!checkHeader(timeline, msg->header, now)) {
       return;
     }
     if (side == &self_ && options_.measurement_frame.empty()) {
@@ -72,10 +73,10 @@ void OdometryInput::onOdometry(Side* side, const nav_msgs::Odometry::ConstPtr& m
     OdometrySample sample;
     if (!odometryInFrame(*msg, world_frame_, options_.odometry.twist_in_body_frame, tf_buffer_,
                          options_.odometry.tf_timeout, &sample, &why)) {
-      side->guard.reject(Rejection::kContent, why);
+      timeline.reject(Rejection::kContent, why);
       return;
     }
-    side->guard.accept(nanosecondsOf(msg->header.stamp), nanosecondsOf(now));
+    timeline.accept();
     side->sample = sample;
     side->frame = world_frame_.empty() ? msg->header.frame_id : world_frame_;
     side->msg = msg;
@@ -91,7 +92,7 @@ void OdometryInput::onOdometry(Side* side, const nav_msgs::Odometry::ConstPtr& m
       combine();  // each own odometry makes a measurement, with the latest of the target's
     }
   });
-  rejected_.fetch_add(side->guard.rejected() - before, std::memory_order_relaxed);
+  rejected_.fetch_add(timeline.rejected() - before, std::memory_order_relaxed);
 }
 
 bool OdometryInput::controlledPoint(std::string* frame, Eigen::Vector3d* point) {

@@ -12,8 +12,9 @@
 #include <tf2_ros/transform_listener.h>
 
 #include "projection_collision_avoidance/RelativeMeasurement.h"
+#include "projection_collision_avoidance/cycle/InputGuard.hpp"
+#include "projection_collision_avoidance/cycle/InputTimeline.hpp"
 #include "projection_collision_avoidance/ros/InputAdmission.hpp"
-#include "projection_collision_avoidance/ros/InputGuard.hpp"
 #include "projection_collision_avoidance/vehicle/RelativeStateFromOdometry.hpp"
 
 #include "follower/FollowerOptions.hpp"
@@ -23,7 +24,7 @@ namespace projection_collision_avoidance {
 
 /// The follower's `odometry` input (~input odometry; doc/vehicles.md): subscribes its own
 /// `odom` and its target's `target_odom` (nav_msgs/Odometry, REP 105: pose in header.frame_id,
-/// twist in child_frame_id), judges each with an InputGuard, brings both into one world frame
+/// twist in child_frame_id), judges each on its InputTimeline, brings both into one world frame
 /// (~measurement_frame, else the own odometry's header.frame_id) with tf2 when a frame differs,
 /// and, at every accepted own odometry, turns it and the target's latest into the relative state
 /// x_target − x_self of the controlled points (RelativeStateFromOdometry: the older sample moved
@@ -53,10 +54,10 @@ class OdometryInput : public MeasurementAdapter {
   double skew() const override { return skew_.load(std::memory_order_relaxed); }
 
  private:
-  /// One agent's side: its guard and latest accepted sample (world frame).
+  /// One agent's side: its input's timeline and latest accepted sample (world frame).
   struct Side {
-    InputGuard guard;
-    ClockWatch clock;
+    Side(std::string topic, const InputGuardLimits& limits) : timeline(std::move(topic), limits) {}
+    InputTimeline timeline;
     OdometrySample sample;  ///< in `frame`
     std::string frame;
     nav_msgs::Odometry::ConstPtr msg;  ///< as received

@@ -37,12 +37,13 @@ PositionInput::PositionInput(std::string node_name, const FollowerNodeOptions& o
       axes_(axes),
       sink_(std::move(sink)),
       filter_(makeFilter(options.position, axes)),
-      skew_(std::numeric_limits<double>::quiet_NaN()) {
-  const InputGuardLimits limits{"", options.max_future_stamp, options.measurement_timeout};
-  point_guard_ = InputGuard("target_position", limits);
-  pose_guard_ = InputGuard("target_pose", limits);
-  tf_guard_ = InputGuard("tf lookup", limits);
-}
+      point_timeline_("target_position",
+                      InputGuardLimits{"", options.max_future_stamp, options.measurement_timeout}),
+      pose_timeline_("target_pose",
+                     InputGuardLimits{"", options.max_future_stamp, options.measurement_timeout}),
+      tf_timeline_("tf lookup",
+                   InputGuardLimits{"", options.max_future_stamp, options.measurement_timeout}),
+      skew_(std::numeric_limits<double>::quiet_NaN()) {}
 
 void PositionInput::start(ros::NodeHandle nh) {
   tf_listener_ = std::make_unique<tf2_ros::TransformListener>(tf_buffer_, nh);
@@ -54,13 +55,13 @@ void PositionInput::start(ros::NodeHandle nh) {
   point_subscriber_ = nh.subscribe<geometry_msgs::PointStamped>(
       "target_position", 10,
       [this](const geometry_msgs::PointStamped::ConstPtr& msg) {
-        onPosition(&point_guard_, msg->header, vectorOf(msg->point));
+        onPosition(&point_timeline_, msg->header, vectorOf(msg->point));
       },
       ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
   pose_subscriber_ = nh.subscribe<geometry_msgs::PoseStamped>(
       "target_pose", 10,
       [this](const geometry_msgs::PoseStamped::ConstPtr& msg) {
-        onPosition(&pose_guard_, msg->header, vectorOf(msg->pose.position));
+        onPosition(&pose_timeline_, msg->header, vectorOf(msg->pose.position));
       },
       ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
 }
@@ -75,22 +76,22 @@ bool PositionInput::controlledPoint(std::string* frame, Eigen::Vector3d* point) 
   return true;
 }
 
-void PositionInput::onPosition(InputGuard* guard, const std_msgs::Header& header,
+void PositionInput::onPosition(InputTimeline* timeline, const std_msgs::Header& header,
                                const Eigen::Vector3d& p) {
   const std::lock_guard<std::mutex> lock(mutex_);
-  const std::uint64_t before = guard->rejected();
-  admitGuarded(*guard, name_, [&] {
+  const std::uint64_t before = timeline->rejected();
+  admitGuarded(*timeline, name_, [&] {
     const ros::Time now = ros::Time::now();
-    if (clock_.wentBack(now)) {  // every source forgets the old timeline
-      point_guard_.restartTimeline();
-      pose_guard_.restartTimeline();
+    if (wentBack(clock_, now)) {  // every source forgets the old timeline
+      point_timeline_.restart();
+      pose_timeline_.restart();
       filter_.reset();
     }
-    if (!checkHeader(*guard, header, now)) {
+    if (!checkHeader(*timeline, header, now)) {
       return;
     }
     if (!p.allFinite()) {
-      guard->reject(Rejection::kContent, "non-finite position");
+      timeline->reject(Rejection::kContent, "non-finite position");
       return;
     }
     Eigen::Vector3d world = p;
@@ -102,31 +103,31 @@ void PositionInput::onPosition(InputGuard* guard, const std_msgs::Header& header
         transform = tf_buffer_.lookupTransform(world_frame, header.frame_id, header.stamp,
                                                ros::Duration(options_.position.tf_timeout));
       } catch (const tf2::TransformException& error) {
-        guard->reject(Rejection::kContent,
-                      "no transform from \"" +
-                          boundedText(header.frame_id, InputGuard::kMaxQuotedLength) + "\" to \"" +
-                          world_frame + "\": " + error.what());
+        timeline->reject(Rejection::kContent,
+                         "no transform from \"" +
+                             boundedText(header.frame_id, InputGuard::kMaxQuotedLength) +
+                             "\" to \"" + world_frame + "\": " + error.what());
         return;
       }
       world = tf2::transformToEigen(transform).rotation() * p;
     }
     std::string why;
     if (!filter(header.stamp, world_frame.empty() ? header.frame_id : world_frame, world, &why)) {
-      guard->reject(Rejection::kContent, why);
+      timeline->reject(Rejection::kContent, why);
       return;
     }
-    guard->accept(nanosecondsOf(header.stamp), nanosecondsOf(now));
+    timeline->accept();
   });
-  rejected_.fetch_add(guard->rejected() - before, std::memory_order_relaxed);
+  rejected_.fetch_add(timeline->rejected() - before, std::memory_order_relaxed);
 }
 
 void PositionInput::onTimer(const ros::TimerEvent& /*event*/) {
   const std::lock_guard<std::mutex> lock(mutex_);
-  const std::uint64_t before = tf_guard_.rejected();
-  admitGuarded(tf_guard_, name_, [&] {
+  const std::uint64_t before = tf_timeline_.rejected();
+  admitGuarded(tf_timeline_, name_, [&] {
     const ros::Time now = ros::Time::now();
-    if (clock_.wentBack(now)) {
-      tf_guard_.restartTimeline();
+    if (wentBack(clock_, now)) {
+      tf_timeline_.restart();
       last_pair_stamp_ = ros::Time();
       filter_.reset();
     }
@@ -142,7 +143,7 @@ void PositionInput::onTimer(const ros::TimerEvent& /*event*/) {
       self = tf_buffer_.lookupTransform(world, o.self_frame, ros::Time());
       target = tf_buffer_.lookupTransform(world, o.target_frame, ros::Time());
     } catch (const tf2::TransformException& error) {
-      tf_guard_.reject(Rejection::kContent, error.what());
+      tf_timeline_.reject(Rejection::kContent, error.what());
       return;
     }
     const ros::Time stamp = std::max(self.header.stamp, target.header.stamp);
@@ -153,13 +154,14 @@ void PositionInput::onTimer(const ros::TimerEvent& /*event*/) {
     std_msgs::Header header;
     header.stamp = stamp;
     header.frame_id = world;
-    if (!checkHeader(tf_guard_, header, now)) {
+    if (!checkHeader(tf_timeline_, header, now)) {
       return;
     }
     const double skew = std::abs(secondsBetween(self.header.stamp, target.header.stamp));
     if (skew > o.max_skew) {
-      tf_guard_.reject(Rejection::kContent, "the transforms' stamps are " + std::to_string(skew) +
-                                                " s apart (> ~tf/max_skew)");
+      tf_timeline_.reject(
+          Rejection::kContent,
+          "the transforms' stamps are " + std::to_string(skew) + " s apart (> ~tf/max_skew)");
       return;
     }
     const Eigen::Isometry3d world_self = tf2::transformToEigen(self);
@@ -174,13 +176,13 @@ void PositionInput::onTimer(const ros::TimerEvent& /*event*/) {
     }
     std::string why;
     if (!filter(stamp, world, target_point - self_point, &why)) {
-      tf_guard_.reject(Rejection::kContent, why);
+      tf_timeline_.reject(Rejection::kContent, why);
       return;
     }
     skew_.store(skew, std::memory_order_relaxed);
-    tf_guard_.accept(nanosecondsOf(stamp), nanosecondsOf(now));
+    tf_timeline_.accept();
   });
-  rejected_.fetch_add(tf_guard_.rejected() - before, std::memory_order_relaxed);
+  rejected_.fetch_add(tf_timeline_.rejected() - before, std::memory_order_relaxed);
 }
 
 bool PositionInput::filter(const ros::Time& stamp, const std::string& frame,

@@ -11,8 +11,10 @@
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
 
+#include "projection_collision_avoidance/cycle/InputGuard.hpp"
+#include "projection_collision_avoidance/cycle/InputTimeline.hpp"
+#include "projection_collision_avoidance/cycle/TimeJumpWatch.hpp"
 #include "projection_collision_avoidance/ros/InputAdmission.hpp"
-#include "projection_collision_avoidance/ros/InputGuard.hpp"
 #include "projection_collision_avoidance/vehicle/RelativeVelocityFilter.hpp"
 
 #include "follower/MeasurementAdapter.hpp"
@@ -29,7 +31,8 @@ namespace projection_collision_avoidance {
 ///   ← ~tf/target_frame; the controlled points ~tf/look_ahead and ~tf/target_look_ahead ahead
 ///   along each body x axis; refused when their stamps differ by more than ~tf/max_skew; stamped
 ///   with the newer; a pair no newer than the last one used is not used again.
-/// Each message or lookup is judged by an InputGuard; nothing a message carries ends the node.
+/// Each message or lookup is judged on its source's InputTimeline; nothing a message carries ends
+/// the node.
 class PositionInput : public MeasurementAdapter {
  public:
   /// @throws ParameterError naming ~position/... (the filter's checks)
@@ -41,8 +44,9 @@ class PositionInput : public MeasurementAdapter {
   bool controlledPoint(std::string* frame, Eigen::Vector3d* point) override;
 
  private:
-  /// One relative position p (m) with @p header, judged by @p guard.
-  void onPosition(InputGuard* guard, const std_msgs::Header& header, const Eigen::Vector3d& p);
+  /// One relative position p (m) with @p header, judged on @p timeline.
+  void onPosition(InputTimeline* timeline, const std_msgs::Header& header,
+                  const Eigen::Vector3d& p);
   /// The ~input tf lookups.
   void onTimer(const ros::TimerEvent& event);
   /// Filters p (in the world frame, stamped @p stamp) and hands on y = [p; v̂] once estimated;
@@ -57,10 +61,10 @@ class PositionInput : public MeasurementAdapter {
   RelativeVelocityFilter filter_;
 
   std::mutex mutex_;  ///< the subscriptions and the timer may call at once (nodelets)
-  InputGuard point_guard_;
-  InputGuard pose_guard_;
-  InputGuard tf_guard_;
-  ClockWatch clock_;
+  InputTimeline point_timeline_;
+  InputTimeline pose_timeline_;
+  InputTimeline tf_timeline_;
+  TimeJumpWatch clock_;  ///< ROS time at every source: a jump back restarts them all
   ros::Time last_pair_stamp_;
   RelativeMeasurement measurement_;
   Eigen::VectorXd state_;

@@ -219,7 +219,7 @@ void PlantClock::rosTick(const ros::Time& expected) {
   if (!running_ || now.isZero()) {
     return;
   }
-  if (clock_.wentBack(now)) {
+  if (wentBack(clock_, now)) {
     ROS_WARN_STREAM(name_ << ": ROS time went back by " << -clock_.jump() << " s, to "
                           << now.toSec() << " s; waiting for it to reach "
                           << stampOf(next_tick_).toSec() << " s again");

@@ -110,7 +110,7 @@ class PlantClock {
   PlantNodeOptions options_;
   std::mutex* mutex_;
   Hooks hooks_;
-  ClockWatch clock_;
+  TimeJumpWatch clock_;
   long next_tick_ = 0;
   long last_tick_ = -1;  ///< tick at the duration; -1 = run forever
   bool started_ = false;

@@ -13,7 +13,7 @@
 #include <geometry_msgs/TwistStamped.h>
 #include <ros/ros.h>
 
-#include "projection_collision_avoidance/ros/InputGuard.hpp"
+#include "projection_collision_avoidance/cycle/InputGuard.hpp"
 #include "projection_collision_avoidance/sim/VehicleModels.hpp"
 
 #include "plant/PlantOptions.hpp"

@@ -39,8 +39,11 @@ PlantWorld::Agent::Agent(const std::string& agent_name, const std::string& tf_fr
       frame(tf_frame),
       integrator(model, step, initial_state, disturbance),
       command(Eigen::VectorXd::Zero(model.inputDimension())),
-      command_guard(agent_name + "/command", {tf_frame, command_timeout, command_timeout}),
-      command_correction(clock_skew) {}
+      // A command stamped ahead of the plant's time by more than the command timeout would never
+      // time out: its sender's clock is not the plant's (a wall-time stamp under simulated
+      // time, say). Jumps back of the plant's time come from its clock (PlantClock's hook).
+      command_timeline(agent_name + "/command",
+                       {{tf_frame, command_timeout, command_timeout}, clock_skew, false}) {}
 
 PlantWorld::PlantWorld(ros::NodeHandle nh, ros::NodeHandle private_nh)
     : nh_(nh),
@@ -109,8 +112,7 @@ PlantWorld::PlantWorld(ros::NodeHandle nh, ros::NodeHandle private_nh)
   hooks.jump = [this](double /*jump*/) {
     // A restarted /clock: commands of the new timeline are judged afresh.
     const auto restart = [](Agent& agent) {
-      agent.command_guard.restartTimeline();
-      agent.command_correction.reset();
+      agent.command_timeline.restart();
       if (agent.vehicle) {
         agent.vehicle->restartTimeline();
       }
@@ -250,34 +252,24 @@ ros::Subscriber PlantWorld::subscribeCommand(
 
 void PlantWorld::onCommand(Agent* agent, const geometry_msgs::AccelStamped::ConstPtr& msg) {
   const std::lock_guard<std::mutex> lock(mutex_);
-  // A command stamped ahead of the plant's time by more than ~command_timeout would never time
-  // out: its sender's clock is not the plant's (a wall-time stamp under simulated time, say).
-  admitGuarded(agent->command_guard, name_, [&] {
-    const ros::Time now = plantNow();
+  InputTimeline& timeline = agent->command_timeline;
+  admitGuarded(timeline, name_, [&] {
     // Judged on the sender's clock, its order on the raw stamps and its age against the plant's
     // time moved by the offset of ~clock_skew/policy (0 by default), as the follower does.
-    const std::int64_t raw = nanosecondsOf(msg->header.stamp);
-    const std::int64_t now_ns = nanosecondsOf(now);
-    const std::int64_t offset = agent->command_correction.offsetFor(raw, now_ns);
-    if (!agent->command_guard.checkHeader(msg->header.frame_id, raw, now_ns - offset)) {
+    if (!checkHeader(timeline, msg->header, plantNow())) {
       return;
     }
     std::string why;
     Eigen::VectorXd command;
     if (!commandFromAccelMsg(*msg, axes_, &command, &why)) {
-      agent->command_guard.reject(Rejection::kContent, why);
+      timeline.reject(Rejection::kContent, why);
       return;
     }
-    if (!agent->command_guard.everAccepted()) {
+    if (!timeline.guard().everAccepted()) {
       ROS_INFO_STREAM(name_ << ": first " << agent->name << "/command received");
     }
     agent->command = command;
-    // On the plant's clock, never before the previous one (the estimate's offset may shrink).
-    agent->command_stamp = agent->command_guard.haveAccepted()
-                               ? std::max(raw + offset, agent->command_stamp + 1)
-                               : raw + offset;
-    agent->command_guard.accept(raw, now_ns - offset);
-    agent->command_correction.accepted(raw, now_ns);
+    timeline.accept();  // on the plant's clock, never before the previous one
   });
 }
 
@@ -355,8 +347,9 @@ bool PlantWorld::commandsAnswer(long k) const {
              (agent.controller_stamp < 0 || agent.controller_subscriber.getNumPublishers() == 0 ||
               agent.controller_stamp >= due);
     }
-    return !agent.command_guard.haveAccepted() ||
-           agent.command_subscriber.getNumPublishers() == 0 || agent.command_stamp >= due;
+    return !agent.command_timeline.guard().haveAccepted() ||
+           agent.command_subscriber.getNumPublishers() == 0 ||
+           agent.command_timeline.stamp() >= due;
   };
   return answered(leader_) &&
          std::all_of(followers_.begin(), followers_.end(),
@@ -368,7 +361,8 @@ bool PlantWorld::everyAgentCommanded() const {
     if (agent.vehicle) {
       return agent.vehicle->commanded();
     }
-    return agent.command_guard.haveAccepted() || agent.command_subscriber.getNumPublishers() == 0;
+    return agent.command_timeline.guard().haveAccepted() ||
+           agent.command_subscriber.getNumPublishers() == 0;
   };
   return commanded(leader_) &&
          std::all_of(followers_.begin(), followers_.end(),
@@ -419,11 +413,11 @@ const PlantWorld::Agent& PlantWorld::targetOf(const Follower& follower) const {
 }
 
 GenericDimensions::InputVector PlantWorld::commandAt(Agent* agent, const ros::Time& now) {
-  const InputGuard& guard = agent->command_guard;
+  const InputGuard& guard = agent->command_timeline.guard();
+  const std::int64_t stamp = agent->command_timeline.stamp();
   const bool fresh =
       guard.haveAccepted() &&
-      std::abs(1e-9 * static_cast<double>(nanosecondsOf(now) - agent->command_stamp)) <=
-          options_.command_timeout;
+      std::abs(1e-9 * static_cast<double>(nanosecondsOf(now) - stamp)) <= options_.command_timeout;
   if (fresh) {
     if (agent->command_timed_out) {
       ROS_INFO_STREAM(name_ << ": " << agent->name << "/command fresh again");
@@ -433,7 +427,7 @@ GenericDimensions::InputVector PlantWorld::commandAt(Agent* agent, const ros::Ti
   }
   if (guard.haveAccepted() && !agent->command_timed_out) {
     ROS_WARN_STREAM(name_ << ": " << agent->name << "/command stamped "
-                          << 1e-9 * static_cast<double>(agent->command_stamp)
+                          << 1e-9 * static_cast<double>(stamp)
                           << " s is older than ~command_timeout (" << options_.command_timeout
                           << " s) at " << now.toSec() << " s: using zero");
     agent->command_timed_out = true;

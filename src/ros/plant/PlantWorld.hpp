@@ -13,9 +13,10 @@
 #include <tf2_ros/transform_broadcaster.h>
 
 #include "projection_collision_avoidance/RelativeMeasurement.h"
+#include "projection_collision_avoidance/cycle/InputGuard.hpp"
+#include "projection_collision_avoidance/cycle/InputTimeline.hpp"
 #include "projection_collision_avoidance/ros/CountedPublisher.hpp"
 #include "projection_collision_avoidance/ros/InputAdmission.hpp"
-#include "projection_collision_avoidance/ros/InputGuard.hpp"
 #include "projection_collision_avoidance/ros/RosParameters.hpp"
 #include "projection_collision_avoidance/sim/AgentIntegrator.hpp"
 #include "projection_collision_avoidance/sim/MeasurementChannel.hpp"
@@ -76,10 +77,9 @@ class PlantWorld {
     std::string frame;  ///< tf frame; commands must carry it as frame_id
     AgentIntegrator<GenericDimensions> integrator;
     Eigen::VectorXd command;  ///< latest accepted command (m/s^2)
-    InputGuard command_guard;
-    StampCorrection command_correction;  ///< the commands' stamps on the plant's clock
-    /// ns: the latest accepted command's stamp on the plant's clock (never before the one before)
-    std::int64_t command_stamp = 0;
+    /// The commands' timeline: judged on the sender's clock, their stamps put on the plant's
+    /// (never before the one before: stamp()); restarted by the plant clock's jump hook.
+    InputTimeline command_timeline;
     bool command_timed_out = false;  ///< the last tick used zero for lack of a fresh command
     ros::Subscriber command_subscriber;
     CountedPublisher odom_publisher;

@@ -1,4 +1,4 @@
-#include "projection_collision_avoidance/ros/InputGuard.hpp"
+#include "projection_collision_avoidance/cycle/InputGuard.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,0 +1,158 @@
+// InputTimeline: one input's admission (verdicts), its stamps on this clock, jumps back of the
+// receiver's clock and its age; TimeJumpWatch. No master.
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+#include <gtest/gtest.h>
+
+#include "projection_collision_avoidance/cycle/InputTimeline.hpp"
+#include "projection_collision_avoidance/cycle/TimeJumpWatch.hpp"
+
+namespace projection_collision_avoidance {
+namespace {
+
+constexpr std::int64_t kSecond = 1000000000;
+constexpr std::int64_t kMs = 1000000;
+constexpr std::int64_t kT0 = 1000 * kSecond;
+
+InputTimelineOptions optionsOf(ClockPolicy policy = ClockPolicy::kStamps) {
+  InputTimelineOptions o;
+  o.limits = {"world", 0.1, 0.5};  // frame, max_future_stamp, max_age
+  o.correction.policy = policy;
+  return o;
+}
+
+TEST(TimeJumpWatch, ReportsEachJumpBackOnce) {
+  TimeJumpWatch watch;
+  EXPECT_FALSE(watch.wentBack(10 * kSecond));
+  EXPECT_FALSE(watch.wentBack(10 * kSecond));  // standing still is no jump
+  EXPECT_FALSE(watch.wentBack(11 * kSecond));
+  EXPECT_EQ(watch.latest(), 11 * kSecond);
+  EXPECT_TRUE(watch.wentBack(2 * kSecond));
+  EXPECT_DOUBLE_EQ(watch.jump(), -9.0);
+  EXPECT_FALSE(watch.wentBack(2 * kSecond + 500 * kMs));
+  EXPECT_EQ(watch.jump(), 0.0);
+  EXPECT_TRUE(watch.wentBack(1));
+  EXPECT_EQ(watch.jumps(), 2u);
+}
+
+TEST(InputTimeline, JudgesHeadersAsItsGuard) {
+  InputTimeline t("topic", optionsOf());
+  EXPECT_FALSE(t.checkHeader("map", kT0, kT0));
+  EXPECT_EQ(t.guard().lastKind(), Rejection::kFrame);
+  EXPECT_FALSE(t.checkHeader("world", 0, kT0));
+  EXPECT_EQ(t.guard().lastKind(), Rejection::kZeroStamp);
+  EXPECT_FALSE(t.checkHeader("world", kT0 + 200 * kMs, kT0));
+  EXPECT_EQ(t.guard().lastKind(), Rejection::kFuture);
+  EXPECT_FALSE(t.checkHeader("world", kT0 - 600 * kMs, kT0));
+  EXPECT_EQ(t.guard().lastKind(), Rejection::kStale);
+  EXPECT_EQ(t.rejected(), 4u);
+  EXPECT_FALSE(t.takeLogLine().empty());
+
+  ASSERT_TRUE(t.checkHeader("world", kT0 - 10 * kMs, kT0));
+  EXPECT_EQ(t.accept(), kT0 - 10 * kMs);
+  EXPECT_FALSE(t.checkHeader("world", kT0 - 10 * kMs, kT0 + kMs));
+  EXPECT_EQ(t.guard().lastKind(), Rejection::kRepeated);
+  EXPECT_FALSE(t.checkHeader("world", kT0 - 20 * kMs, kT0 + kMs));
+  EXPECT_EQ(t.guard().lastKind(), Rejection::kOutOfOrder);
+  ASSERT_TRUE(t.checkHeader("world", kT0, kT0 + 2 * kMs));
+  t.reject(Rejection::kContent, "non-finite");
+  EXPECT_EQ(t.rejected(), 7u);
+  EXPECT_EQ(t.guard().accepted(), 1u);
+  EXPECT_EQ(t.guard().lastRejection(), "content: non-finite");
+}
+
+TEST(InputTimeline, AgeIsInfiniteWithoutInputAndCountsFromTheEarlierOfStampAndReceipt) {
+  InputTimeline t("topic", optionsOf());
+  EXPECT_EQ(t.age(kT0), kNoInputAge);
+  EXPECT_TRUE(std::isinf(t.age(kT0)) && t.age(kT0) > 0.0);
+  EXPECT_EQ(t.receipt(), InputTimeline::kNone);
+
+  ASSERT_TRUE(t.checkHeader("world", kT0 - 30 * kMs, kT0));
+  t.accept();
+  EXPECT_EQ(t.receipt(), kT0);
+  EXPECT_NEAR(t.age(kT0), 0.030, 1e-12);
+  EXPECT_NEAR(t.age(kT0 + 100 * kMs), 0.130, 1e-12);
+  EXPECT_NEAR(t.skew(), 0.030, 1e-12);
+  EXPECT_EQ(t.age(kT0 - kMs), kNoInputAge);  // received after then: of another timeline
+
+  // Stamped ahead (within max_future_stamp): counts from its receipt.
+  ASSERT_TRUE(t.checkHeader("world", kT0 + 60 * kMs, kT0 + 10 * kMs));
+  t.accept();
+  EXPECT_NEAR(t.age(kT0 + 10 * kMs), 0.0, 1e-12);
+  EXPECT_NEAR(t.age(kT0 + 30 * kMs), 0.020, 1e-12);
+  // The one age function.
+  EXPECT_EQ(t.age(kT0 + 30 * kMs), inputAge(kT0 + 30 * kMs, t.stamp(), t.receipt()));
+}
+
+TEST(InputTimeline, AJumpBackRestartsTheTimeline) {
+  InputTimeline t("topic", optionsOf());
+  ASSERT_TRUE(t.checkHeader("world", kT0, kT0 + kMs));
+  t.accept();
+  // ROS time restarts 100 s earlier: the old input is forgotten, a new one is not out of order.
+  ASSERT_TRUE(t.checkHeader("world", kT0 - 100 * kSecond, kT0 - 100 * kSecond));
+  EXPECT_EQ(t.jumps().jumps(), 1u);
+  EXPECT_NEAR(t.jumps().jump(), -100.001, 1e-9);
+  EXPECT_EQ(t.age(kT0 - 100 * kSecond), kNoInputAge);
+  EXPECT_FALSE(t.guard().haveAccepted());
+  EXPECT_TRUE(t.guard().everAccepted());
+  EXPECT_EQ(t.accept(), kT0 - 100 * kSecond);
+  EXPECT_NEAR(t.age(kT0 - 100 * kSecond + 5 * kMs), 0.005, 1e-12);
+  EXPECT_EQ(t.guard().accepted(), 2u);
+
+  // noteTime() reports a jump once, and checkHeader() at the same time sees none.
+  EXPECT_TRUE(t.noteTime(kT0 - 200 * kSecond));
+  EXPECT_FALSE(t.checkHeader("world", kT0 - 300 * kSecond, kT0 - 200 * kSecond));  // stale
+  EXPECT_EQ(t.jumps().jumps(), 2u);
+}
+
+TEST(InputTimeline, WithoutWatchingTimeOnlyRestartForgets) {
+  InputTimelineOptions o = optionsOf();
+  o.watch_time = false;
+  InputTimeline t("topic", o);
+  ASSERT_TRUE(t.checkHeader("world", kT0, kT0));
+  t.accept();
+  EXPECT_FALSE(t.checkHeader("world", kT0 - 10 * kSecond, kT0 - 10 * kSecond));
+  EXPECT_EQ(t.guard().lastKind(), Rejection::kOutOfOrder);
+  EXPECT_EQ(t.jumps().jumps(), 0u);
+  t.restart();
+  EXPECT_TRUE(t.checkHeader("world", kT0 - 10 * kSecond, kT0 - 10 * kSecond));
+}
+
+TEST(InputTimeline, ReceiptPolicyStampsAtReceiptAndKeepsStampsMonotone) {
+  InputTimeline t("topic", optionsOf(ClockPolicy::kReceipt));
+  // A sender 2 s ahead: judged at its own clock, put on this one.
+  ASSERT_TRUE(t.checkHeader("world", kT0 + 2 * kSecond, kT0));
+  EXPECT_EQ(t.offset(), -2 * kSecond);
+  EXPECT_EQ(t.accept(), kT0);
+  EXPECT_NEAR(t.age(kT0), 0.0, 1e-12);
+  EXPECT_NEAR(t.skew(), -2.0, 1e-12);
+  // This clock stands still (simulated time): the next stamp still lies after the last one.
+  ASSERT_TRUE(t.checkHeader("world", kT0 + 2 * kSecond + kMs, kT0));
+  EXPECT_EQ(t.accept(), kT0 + 1);
+}
+
+TEST(InputTimeline, EstimatedOffsetCorrectsStampsAndNeverGoesBack) {
+  InputTimeline t("topic", optionsOf(ClockPolicy::kEstimate));
+  const std::int64_t behind = 2 * kSecond;  // the sender's clock is 2 s behind
+  // Delay 10 ms: the first offset is the message's own skew.
+  ASSERT_TRUE(t.checkHeader("world", kT0 - behind - 10 * kMs, kT0));
+  EXPECT_EQ(t.offset(), behind + 10 * kMs);
+  EXPECT_EQ(t.accept(), kT0);
+  // Delay 3 ms: corrected with the window's smallest skew so far (2.010 s), 7 ms ahead.
+  ASSERT_TRUE(t.checkHeader("world", kT0 - behind - 2 * kMs, kT0 + kMs));
+  EXPECT_EQ(t.offset(), behind + 10 * kMs);
+  EXPECT_EQ(t.accept(), kT0 + 8 * kMs);
+  EXPECT_NEAR(t.skew(), 2.003, 1e-12);
+  // The estimate shrinks to 2.003 s: stamp + offset (kT0 + 3 ms) would lie before the stamp
+  // accepted before, so the stamp is 1 ns after it.
+  ASSERT_TRUE(t.checkHeader("world", kT0 - behind, kT0 + 4 * kMs));
+  EXPECT_EQ(t.offset(), behind + 3 * kMs);
+  EXPECT_EQ(t.accept(), kT0 + 8 * kMs + 1);
+  // Stamped after its receipt: its age counts from the receipt.
+  EXPECT_NEAR(t.age(kT0 + 10 * kMs), 0.006, 1e-9);
+}
+
+}  // namespace
+}  // namespace projection_collision_avoidance
