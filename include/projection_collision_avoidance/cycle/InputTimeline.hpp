@@ -7,8 +7,8 @@
 #include <utility>
 
 #include "projection_collision_avoidance/cycle/InputGuard.hpp"
-#include "projection_collision_avoidance/cycle/TimeJumpWatch.hpp"
 #include "projection_collision_avoidance/cycle/StampCorrection.hpp"
+#include "projection_collision_avoidance/cycle/TimeJumpWatch.hpp"
 
 namespace projection_collision_avoidance {
 
