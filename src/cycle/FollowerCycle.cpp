@@ -31,119 +31,28 @@ std::uint32_t skippedPeriods(double gap, double period) {
 
 FollowerCycle::FollowerCycle(std::unique_ptr<DynamicFollowerController> controller,
                              const Eigen::VectorXd& separation, FollowerCycleSettings settings)
-    : controller_(std::move(controller)), separation_(separation), settings_(settings) {
-  if (!controller_ || separation.size() != controller_->stateDimension()) {
+    : handover_(std::move(controller)),
+      separation_(separation),
+      settings_(settings),
+      period_(handover_.current().design().period),
+      stall_wait_(settings.measurement_timeout, period_) {
+  if (separation.size() != handover_.current().stateDimension()) {
     throw std::invalid_argument("FollowerCycle: a controller and d of its state's size");
   }
-  period_ = controller_->design().period;
-  y_.resize(controller_->outputDimension());
+  y_.resize(handover_.current().outputDimension());
 }
 
-FollowerCycle::~FollowerCycle() {
-  delete offered_.exchange(nullptr);
-  delete retired_.exchange(nullptr);
-}
-
-std::unique_ptr<DynamicFollowerController> FollowerCycle::offer(
-    std::unique_ptr<DynamicFollowerController> controller) {
-  if (!controller || controller->stateDimension() != controller_->stateDimension() ||
-      controller->inputDimension() != controller_->inputDimension() ||
-      controller->outputDimension() != controller_->outputDimension()) {
-    throw std::invalid_argument("FollowerCycle::offer: a controller of the same model sizes");
-  }
-  return std::unique_ptr<DynamicFollowerController>(offered_.exchange(controller.release()));
-}
-
-std::unique_ptr<DynamicFollowerController> FollowerCycle::retired() {
-  return std::unique_ptr<DynamicFollowerController>(retired_.exchange(nullptr));
-}
-
-void FollowerCycle::adoptOffered() {
-  if (retired_.load(std::memory_order_acquire) != nullptr) {
-    return;  // the previous one is not collected yet: adopt at a later tick
-  }
-  DynamicFollowerController* next = offered_.exchange(nullptr);
-  if (next == nullptr) {
-    return;
-  }
-  next->adoptStateOf(*controller_);
-  retired_.store(controller_.release(), std::memory_order_release);
-  controller_.reset(next);
-}
-
-void FollowerCycle::latchInputs() {
-  if (measurement_.read()) {
-    ever_measured_ = true;
-  }
-  if (leader_.read()) {
-    ever_led_ = true;
-  }
-  if (own_state_.read()) {
-    ever_own_state_ = true;
-  }
-}
-
-void FollowerCycle::checkTimeline(std::int64_t now_ns) {
-  // An input of the old timeline (received after now: ROS time went back) is not valid.
-  have_measurement_ = ever_measured_ && measurement_.value().receipt_ns <= now_ns;
-  have_leader_ = ever_led_ && leader_.value().receipt_ns <= now_ns;
-  have_own_state_ = ever_own_state_ && own_state_.value().receipt_ns <= now_ns;
-}
+FollowerCycle::~FollowerCycle() = default;
 
 bool FollowerCycle::tickLatched(std::int64_t now_ns, std::int64_t steady_ns, double delay,
                                 std::uint32_t skipped, FollowerCycleOutput* out) {
   out->stepped = false;
-  stall_ = 0.0;
   time_.wentBack(now_ns);  // counted and reported (time_jump) by fillCounters()
-  checkTimeline(now_ns);
-
-  const double grace = 0.5 * settings_.measurement_timeout;
-  // A stall: the tick ran late by a good part of the timeout on ROS time (delay), or the process
-  // did not tick for that long on the steady clock (a simulated clock replayed after a stall
-  // passes its periods one by one, so that each tick looks on time).
-  const double gap =
-      have_last_tick_steady_
-          ? kNanosecond * static_cast<double>(steady_ns - last_tick_steady_ns_) - period_
-          : 0.0;
-  last_tick_steady_ns_ = steady_ns;
-  have_last_tick_steady_ = true;
-  // Measurements refused as stamped ahead of this clock since the tick before.
-  const std::uint64_t future = future_measurements_.load(std::memory_order_relaxed);
-  if (future != future_seen_) {
-    future_seen_ = future;
-    last_future_steady_ns_ = steady_ns;
-    have_future_ = true;
-  }
-  const double stalled = std::max(delay, gap);
-  if (stalled > grace) {
-    // The measurements sent meanwhile are not read yet: wait for them. After a stall seen on the
-    // steady clock alone, only while measurements are refused as future (a replaying clock; a
-    // lockstep simulation that stood still with everyone else refuses none).
-    resuming_ = true;
-    wait_anchored_ = delay > grace;
-    resumed_at_steady_ns_ = steady_ns;
-    stall_began_steady_ns_ = steady_ns;
-    wait_limit_ = std::max(settings_.measurement_timeout, stalled);
-    sequence_at_stall_ = measurement_.value().sequence;
-    stall_ = stalled;
-  }
-  if (resuming_) {
-    // A measurement refused as future: this clock is still catching up, and the measurements
-    // will be accepted once it has. Wait on from then, for at most wait_limit_ in all.
-    if (have_future_ && last_future_steady_ns_ >= stall_began_steady_ns_ &&
-        (!wait_anchored_ || last_future_steady_ns_ > resumed_at_steady_ns_)) {
-      resumed_at_steady_ns_ = last_future_steady_ns_;
-      wait_anchored_ = true;
-    }
-    const double quiet = kNanosecond * static_cast<double>(steady_ns - resumed_at_steady_ns_);
-    const double waited = kNanosecond * static_cast<double>(steady_ns - stall_began_steady_ns_);
-    if (measurement_.value().sequence == sequence_at_stall_ && wait_anchored_ && quiet < grace &&
-        waited < wait_limit_) {
-      addSaturated(&missed_periods_, skipped + 1);
-      fillCounters(now_ns, out);
-      return false;
-    }
-    resuming_ = false;
+  inputs_.checkTimeline(now_ns);
+  if (stall_wait_.holds(steady_ns, delay, inputs_.measurement().sequence)) {
+    addSaturated(&missed_periods_, skipped + 1);
+    fillCounters(now_ns, out);
+    return false;
   }
   if (!settings_.measurement_trigger) {
     addSaturated(&missed_periods_, skipped);
@@ -151,10 +60,8 @@ bool FollowerCycle::tickLatched(std::int64_t now_ns, std::int64_t steady_ns, dou
   }
   // Measurement trigger: the measurements run the steps while they are fresh; a tick only
   // brakes once they are stale.
-  const bool fresh = have_measurement_ &&
-                     inputAge(now_ns, measurement_.value().stamp_ns,
-                              measurement_.value().receipt_ns) <= settings_.measurement_timeout;
-  if (ever_measured_ && !fresh) {
+  const bool fresh = inputs_.measurementAge(now_ns) <= settings_.measurement_timeout;
+  if (inputs_.everMeasured() && !fresh) {
     return step(now_ns, now_ns, delay, out);
   }
   fillCounters(now_ns, out);
@@ -163,28 +70,24 @@ bool FollowerCycle::tickLatched(std::int64_t now_ns, std::int64_t steady_ns, dou
 
 bool FollowerCycle::stepOnLatchedMeasurement(std::int64_t now_ns, std::uint32_t skipped,
                                              FollowerCycleOutput* out) {
-  checkTimeline(now_ns);
-  if (!have_measurement_) {
+  inputs_.checkTimeline(now_ns);
+  if (!inputs_.haveMeasurement()) {
     out->stepped = false;
     fillCounters(now_ns, out);
     return false;
   }
   addSaturated(&missed_periods_, skipped);
-  const MeasurementSample& m = measurement_.value();
+  const MeasurementSample& m = inputs_.measurement();
   return step(now_ns, m.stamp_ns, kNanosecond * static_cast<double>(now_ns - m.stamp_ns), out);
 }
 
 bool FollowerCycle::step(std::int64_t now_ns, std::int64_t stamp_ns, double delay,
                          FollowerCycleOutput* out) {
   FollowerInputAges ages;
-  ages.have_measurement = ever_measured_;
-  ages.measurement_age = have_measurement_ ? inputAge(stamp_ns, measurement_.value().stamp_ns,
-                                                      measurement_.value().receipt_ns)
-                                           : kNoInputAge;
-  ages.have_leader = ever_led_;
-  ages.leader_age = have_leader_
-                        ? inputAge(stamp_ns, leader_.value().stamp_ns, leader_.value().receipt_ns)
-                        : kNoInputAge;
+  ages.have_measurement = inputs_.everMeasured();
+  ages.measurement_age = inputs_.measurementAge(stamp_ns);
+  ages.have_leader = inputs_.everLed();
+  ages.leader_age = inputs_.leaderAge(stamp_ns);
   mode_ = selectFollowerMode(
       ages, FollowerTimeouts{settings_.measurement_timeout, settings_.leader_timeout});
   out->stepped = false;
@@ -198,31 +101,30 @@ bool FollowerCycle::step(std::int64_t now_ns, std::int64_t stamp_ns, double dela
   if (delay > 0.5 * period_) {
     addSaturated(&late_periods_, 1);
   }
-  out->leader_fresh = have_leader_ && ages.leader_age <= settings_.leader_timeout;
+  out->leader_fresh = inputs_.haveLeader() && ages.leader_age <= settings_.leader_timeout;
   const bool use_leader = settings_.use_leader_input && out->leader_fresh;
-  const ControllerDesign& design = controller_->design();
-  const GenericDimensions::StateVector& state = measurement_.value().relative_state;
+  DynamicFollowerController& controller = handover_.current();
+  const ControllerDesign& design = controller.design();
+  const GenericDimensions::StateVector& state = inputs_.measurement().relative_state;
   out->xi = state - separation_;
   const Eigen::Index axes = design.parameters.model.position_dimension;
   out->distance = state.head(axes).norm();
   // The time headway (S1) acts from the own state while it is fresh; without it the step runs
   // the paper's constant spacing.
-  const OwnStateSample& own = own_state_.value();
-  out->own_state_fresh =
-      design.parameters.time_headway > 0.0 && have_own_state_ &&
-      inputAge(stamp_ns, own.stamp_ns, own.receipt_ns) <= settings_.measurement_timeout;
+  out->own_state_fresh = design.parameters.time_headway > 0.0 &&
+                         inputs_.ownStateAge(stamp_ns) <= settings_.measurement_timeout;
   DynamicStepInputs inputs;  // without a measurement the step runs the fallback
   if (mode_ != FollowerMode::kMeasurementLost) {
     y_.noalias() = design.parameters.model.C * out->xi;
     inputs.measurement.emplace(y_);
     if (out->own_state_fresh) {
-      inputs.own_state.emplace(own.state);
+      inputs.own_state.emplace(inputs_.ownState().state);
     }
   }
   if (use_leader) {
-    inputs.leader_input.emplace(leader_.value().acceleration);
+    inputs.leader_input.emplace(inputs_.leader().acceleration);
   }
-  const DynamicFollowerStatus* status = &controller_->step(inputs);
+  const DynamicFollowerStatus* status = &controller.step(inputs);
   out->stepped = true;
   out->stamp_ns = stamp_ns;
   out->steps = steps_;
@@ -241,11 +143,11 @@ void FollowerCycle::fillCounters(std::int64_t now_ns, FollowerCycleOutput* out) 
   out->tick_delay = tick_delay_;
   out->time_jumps = time_.jumps();
   out->time_jump = time_.jump();
-  out->stall = stall_;
+  out->stall = stall_wait_.stall();
   if (!out->stepped) {
     out->steps = steps_;
   }
-  const ControllerDesign& design = controller_->design();
+  const ControllerDesign& design = handover_.current().design();
   out->xi_max = design.xi_max;
   out->xi_soft = design.xi_soft;
   out->perimeter = design.perimeter;

@@ -145,7 +145,12 @@ TEST(FollowerCycle, TheControlThreadAllocatesAndFreesNothing) {
       if (k == 6000) {
         cycle->offer(std::move(offered));  // built on another thread; adopted by a tick
       }
-      cycle->tick(now, 0.0, 0, &out);
+      // The path the node's real-time thread ticks by (FollowerLoop::onThreadTick()), on time.
+      PeriodicTick tick;
+      tick.index = static_cast<std::uint64_t>(k);
+      tick.expected = tick.actual = now;
+      tick.period = kMs;
+      cycle->tickOn(tick, [now] { return now; }, &out);
       outputs.post(out);
       std::this_thread::sleep_for(std::chrono::microseconds(50));
     }

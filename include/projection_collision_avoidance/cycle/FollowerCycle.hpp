@@ -1,47 +1,29 @@
 #pragma once
 
-#include <atomic>
+#include <algorithm>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <type_traits>
+#include <utility>
 
 #include "projection_collision_avoidance/core/DynamicFollowerController.hpp"
 #include "projection_collision_avoidance/core/FollowerMode.hpp"
 #include "projection_collision_avoidance/core/TypeDefs.hpp"
+#include "projection_collision_avoidance/cycle/ControllerHandover.hpp"
 #include "projection_collision_avoidance/cycle/InputTimeline.hpp"
+#include "projection_collision_avoidance/cycle/LatchedInputs.hpp"
+#include "projection_collision_avoidance/cycle/StallWait.hpp"
 #include "projection_collision_avoidance/cycle/TimeJumpWatch.hpp"
 #include "projection_collision_avoidance/rt/LatestValue.hpp"
+#include "projection_collision_avoidance/rt/PeriodicThread.hpp"
 
 namespace projection_collision_avoidance {
 
 /// Control periods skipped between two consecutive due times @p gap s apart (s): none up to 1.5
 /// periods, else round(gap / period) - 1 (saturated).
 std::uint32_t skippedPeriods(double gap, double period);
-
-/// One accepted relative measurement, as the input side hands it to the control cycle.
-struct MeasurementSample {
-  std::int64_t stamp_ns = 0;    ///< its header stamp (ns since the epoch)
-  std::int64_t receipt_ns = 0;  ///< ROS time when it was accepted (ns)
-  std::uint64_t sequence = 0;   ///< measurements accepted so far, this one included
-  GenericDimensions::StateVector relative_state;  ///< x_target - x_i (m, m/s)
-};
-
-/// One accepted leader broadcast: the target's acceleration as the follower uses it.
-struct LeaderSample {
-  std::int64_t stamp_ns = 0;
-  std::int64_t receipt_ns = 0;
-  std::uint64_t sequence = 0;
-  GenericDimensions::InputVector acceleration;  ///< a_target (m/s^2)
-};
-
-/// One accepted odometry of the follower itself: its own state, from which a time headway acts.
-struct OwnStateSample {
-  std::int64_t stamp_ns = 0;
-  std::int64_t receipt_ns = 0;
-  std::uint64_t sequence = 0;
-  GenericDimensions::StateVector state;  ///< x_i (m, m/s)
-};
 
 /// What the follower's control cycle needs besides the controller's design.
 struct FollowerCycleSettings {
@@ -98,14 +80,12 @@ struct FollowerCycleOutput {
 /// while it was received at or before now (after a jump back of ROS time, those of the old timeline
 /// are not, so the follower brakes until new ones arrive); its age is inputAge(), from
 /// min(stamp, receipt), as InputTimeline::age() reports it, and +inf (kNoInputAge) when none.
-/// A stalled process (a tick more than half the measurement timeout late on ROS time, or that long
-/// after the tick before on the steady clock) starts a wait: ticks are skipped and counted as
-/// missed until a measurement is accepted, or half the timeout has passed on the steady clock
-/// since the wait began (late on ROS time only) or since the latest measurement refused as
-/// stamped ahead of this clock (noteFutureMeasurement()), but at most max(measurement timeout,
-/// the stall) in all. Simulated time can catch up by seconds within a millisecond when a stalled
-/// process resumes, before the measurements sent meanwhile are read, or replay the stall period by
-/// period, refusing the newest measurements as future until it has caught up.
+/// A stalled process starts a wait in which ticks are skipped and counted as missed (StallWait).
+///
+/// Its parts, one job each: LatchedInputs (the slots, what was latched, which inputs are of this
+/// timeline, their ages), TimeJumpWatch (ROS time going back), StallWait (the wait after a stall),
+/// ControllerHandover (the controller in force and a new design's); the cycle itself picks the
+/// mode, counts periods and steps.
 class FollowerCycle {
  public:
   /// @param controller the controller, moved in
@@ -117,11 +97,11 @@ class FollowerCycle {
   FollowerCycle& operator=(const FollowerCycle&) = delete;
 
   /// The slot the measurement callback writes (one writer thread).
-  LatestValue<MeasurementSample>& measurement() { return measurement_; }
+  LatestValue<MeasurementSample>& measurement() { return inputs_.measurementSlot(); }
   /// The slot the leader-broadcast callback writes (one writer thread).
-  LatestValue<LeaderSample>& leader() { return leader_; }
+  LatestValue<LeaderSample>& leader() { return inputs_.leaderSlot(); }
   /// The slot the own odometry's callback writes (one writer thread; time headway only).
-  LatestValue<OwnStateSample>& ownState() { return own_state_; }
+  LatestValue<OwnStateSample>& ownState() { return inputs_.ownStateSlot(); }
 
   /// A tick of the fixed-rate loop at steady (monotonic) time @p steady_ns, @p delay s after it
   /// was due, with @p skipped periods skipped before it. It latches the inputs first and then
@@ -138,14 +118,26 @@ class FollowerCycle {
     if (settings_.measurement_trigger) {
       lock.lock();  // a measurement's step may be running in its callback: wait for it
     }
-    adoptOffered();
-    latchInputs();
+    handover_.adopt();
+    inputs_.latch();
     return tickLatched(ros_now(), steady_ns, delay, skipped, out);
   }
   /// tick() at the given ROS time @p now_ns.
   bool tick(std::int64_t now_ns, std::int64_t steady_ns, double delay, std::uint32_t skipped,
             FollowerCycleOutput* out) {
     return tick([now_ns] { return now_ns; }, steady_ns, delay, skipped, out);
+  }
+  /// tick() for a PeriodicTick of the real-time thread (PeriodicThread, SharedTicker), the one
+  /// path by which those threads tick: delay (s) from the tick's due and actual steady times, the
+  /// periods it skipped (saturated to 32 bits), ROS time from @p ros_now once the inputs are
+  /// latched.
+  template <typename RosNow,
+            typename = std::enable_if_t<std::is_invocable_r_v<std::int64_t, RosNow&>>>
+  bool tickOn(const PeriodicTick& tick, RosNow&& ros_now, FollowerCycleOutput* out) {
+    const double delay = 1e-9 * static_cast<double>(tick.actual - tick.expected);
+    const std::uint64_t most = std::numeric_limits<std::uint32_t>::max();
+    return this->tick(std::forward<RosNow>(ros_now), tick.actual, delay,
+                      static_cast<std::uint32_t>(std::min(tick.skipped, most)), out);
   }
   /// tick() where ROS time is the steady clock (wall time that does not jump).
   bool tick(std::int64_t now_ns, double delay, std::uint32_t skipped, FollowerCycleOutput* out) {
@@ -159,8 +151,8 @@ class FollowerCycle {
             typename = std::enable_if_t<std::is_invocable_r_v<std::int64_t, RosNow&>>>
   bool stepOnMeasurement(RosNow&& ros_now, std::uint32_t skipped, FollowerCycleOutput* out) {
     const std::lock_guard<std::mutex> lock(trigger_mutex_);
-    adoptOffered();
-    latchInputs();
+    handover_.adopt();
+    inputs_.latch();
     return stepOnLatchedMeasurement(ros_now(), skipped, out);
   }
   /// stepOnMeasurement() at the given ROS time @p now_ns.
@@ -171,67 +163,40 @@ class FollowerCycle {
   /// The input side refused a measurement stamped ahead of this process's clock (any thread,
   /// lock-free). While a tick waits after a stall, each one extends the wait: the clock is still
   /// catching up, and measurements will be accepted once it has.
-  void noteFutureMeasurement() { future_measurements_.fetch_add(1, std::memory_order_relaxed); }
+  void noteFutureMeasurement() { stall_wait_.noteFutureMeasurement(); }
 
   /// Hands over a controller for a new design (built elsewhere, e.g. by reconfiguration); a
   /// coming tick adopts it, carrying over the estimate and previous command, once the controller
   /// it replaced last time has been collected with retired(). A controller offered before and
   /// not yet adopted is returned for disposal.
   std::unique_ptr<DynamicFollowerController> offer(
-      std::unique_ptr<DynamicFollowerController> controller);
+      std::unique_ptr<DynamicFollowerController> controller) {
+    return handover_.offer(std::move(controller));
+  }
   /// The controller replaced by the last adoption, for disposal off the control thread.
-  std::unique_ptr<DynamicFollowerController> retired();
+  std::unique_ptr<DynamicFollowerController> retired() { return handover_.retired(); }
 
   /// Design in force at the last tick (read it from the control thread only, or before start).
-  const ControllerDesign& design() const { return controller_->design(); }
+  const ControllerDesign& design() const { return handover_.current().design(); }
 
  private:
   /// One control step at ROS time @p now_ns, stamped @p stamp_ns, @p delay s after it was due.
   bool step(std::int64_t now_ns, std::int64_t stamp_ns, double delay, FollowerCycleOutput* out);
-  /// Reads the latest inputs from their slots.
-  void latchInputs();
-  /// Which latched inputs are of this timeline at ROS time @p now_ns (received at or before it).
-  void checkTimeline(std::int64_t now_ns);
   bool tickLatched(std::int64_t now_ns, std::int64_t steady_ns, double delay, std::uint32_t skipped,
                    FollowerCycleOutput* out);
   bool stepOnLatchedMeasurement(std::int64_t now_ns, std::uint32_t skipped,
                                 FollowerCycleOutput* out);
-  void adoptOffered();
   /// The counters and the design in force into @p out (whether or not a step ran).
   void fillCounters(std::int64_t now_ns, FollowerCycleOutput* out) const;
 
-  std::unique_ptr<DynamicFollowerController> controller_;
-  std::atomic<DynamicFollowerController*> offered_{nullptr};
-  std::atomic<DynamicFollowerController*> retired_{nullptr};
+  ControllerHandover handover_;  ///< the controller in force, and a new design's
   GenericDimensions::StateVector separation_;
   FollowerCycleSettings settings_;
   double period_ = 0.0;
   std::mutex trigger_mutex_;  ///< measurement trigger only: callback steps vs braking ticks
-
-  LatestValue<MeasurementSample> measurement_;
-  LatestValue<LeaderSample> leader_;
-  LatestValue<OwnStateSample> own_state_;
-  bool have_measurement_ = false;  ///< a measurement valid on this timeline
-  bool ever_measured_ = false;     ///< a measurement was accepted since start
-  bool have_leader_ = false;
-  bool ever_led_ = false;
-  bool have_own_state_ = false;
-  bool ever_own_state_ = false;
-
-  TimeJumpWatch time_;                     ///< jumps back of ROS time at the ticks
-  bool resuming_ = false;                  ///< waiting for input after a stall
-  std::int64_t resumed_at_steady_ns_ = 0;  ///< the wait's start, or the latest future refusal
-  std::int64_t stall_began_steady_ns_ = 0;
-  double wait_limit_ = 0.0;  ///< s of steady time the wait may last in all
-  std::uint64_t sequence_at_stall_ = 0;
-  std::atomic<std::uint64_t> future_measurements_{0};  ///< noteFutureMeasurement() calls
-  std::uint64_t future_seen_ = 0;                      ///< the count at the tick before
-  bool have_future_ = false;
-  std::int64_t last_future_steady_ns_ = 0;  ///< the tick that saw the latest future refusal
-  bool wait_anchored_ = false;  ///< the wait has a start: late on ROS time, or a future refusal
-  bool have_last_tick_steady_ = false;
-  std::int64_t last_tick_steady_ns_ = 0;
-  double stall_ = 0.0;
+  LatchedInputs inputs_;
+  TimeJumpWatch time_;    ///< jumps back of ROS time at the ticks
+  StallWait stall_wait_;  ///< the wait for input after a stall
 
   FollowerMode mode_ = FollowerMode::kWaiting;
   std::uint64_t steps_ = 0;

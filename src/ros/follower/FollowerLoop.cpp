@@ -97,10 +97,7 @@ void FollowerLoop::onThreadTick(const PeriodicTick& tick) {
     return;
   }
   try {
-    const double delay = 1e-9 * static_cast<double>(tick.actual - tick.expected);
-    const std::uint64_t most = std::numeric_limits<std::uint32_t>::max();
-    cycle_->tick(rosNanoseconds, tick.actual, delay,
-                 static_cast<std::uint32_t>(std::min(tick.skipped, most)), &thread_output_);
+    cycle_->tickOn(tick, rosNanoseconds, &thread_output_);
     if (post_outputs_) {
       outputs_->post(thread_output_);
     } else {
