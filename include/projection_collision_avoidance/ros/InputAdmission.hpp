@@ -36,47 +36,30 @@ inline bool checkHeader(InputGuard& guard, const std_msgs::Header& header, const
   return guard.checkHeader(header.frame_id, nanosecondsOf(header.stamp), nanosecondsOf(now));
 }
 
-/// Logs (WARN, prefixed with @p node) the line @p guard asks for, if any.
-inline void logRejection(InputGuard& guard, const std::string& node) {
-  const std::string line = guard.takeLogLine();
+/// Logs (WARN, prefixed with @p node) the line @p admission (an InputGuard or an InputTimeline)
+/// asks for, if any.
+template <typename Admission>
+void logRejection(Admission& admission, const std::string& node) {
+  const std::string line = admission.takeLogLine();
   if (!line.empty()) {
     ROS_WARN_STREAM(node << ": " << line);
   }
 }
 
 /// Runs @p judge (the checks and the use of one input message) so that nothing it throws
-/// leaves the callback: a message that cannot be judged is refused as kUnjudgeable and counted.
-/// Then logs what the guard asks for.
-template <typename Judge>
-void admitGuarded(InputGuard& guard, const std::string& node, Judge&& judge) noexcept {
+/// leaves the callback: a message that cannot be judged is refused as kUnjudgeable and counted
+/// by @p admission (an InputGuard or an InputTimeline). Then logs what it asks for.
+template <typename Admission, typename Judge>
+void admitGuarded(Admission& admission, const std::string& node, Judge&& judge) noexcept {
   try {
     try {
       judge();
     } catch (const std::exception& error) {
-      guard.reject(Rejection::kUnjudgeable, error.what());
+      admission.reject(Rejection::kUnjudgeable, error.what());
     } catch (...) {
-      guard.reject(Rejection::kUnjudgeable, "unknown exception");
+      admission.reject(Rejection::kUnjudgeable, "unknown exception");
     }
-    logRejection(guard, node);
-  } catch (...) {  // out of memory while counting: drop the message, keep the node
-  }
-}
-
-/// admitGuarded() for an InputTimeline: refusals and log lines go through it.
-template <typename Judge>
-void admitGuarded(InputTimeline& timeline, const std::string& node, Judge&& judge) noexcept {
-  try {
-    try {
-      judge();
-    } catch (const std::exception& error) {
-      timeline.reject(Rejection::kUnjudgeable, error.what());
-    } catch (...) {
-      timeline.reject(Rejection::kUnjudgeable, "unknown exception");
-    }
-    const std::string line = timeline.takeLogLine();
-    if (!line.empty()) {
-      ROS_WARN_STREAM(node << ": " << line);
-    }
+    logRejection(admission, node);
   } catch (...) {  // out of memory while counting: drop the message, keep the node
   }
 }
