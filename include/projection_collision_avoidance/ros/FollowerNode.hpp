@@ -12,6 +12,7 @@ class FollowerLoop;
 class MeasurementAdapter;
 class FollowerOutputs;
 class FollowerReconfigure;
+class MeasurementTrigger;
 struct FollowerConfiguration;
 
 /// ROS wrapper of DynamicFollowerController: translates messages and time, nothing else.
@@ -93,6 +94,7 @@ class FollowerNode {
   std::unique_ptr<FollowerInputs> inputs_;
   std::unique_ptr<MeasurementAdapter> input_adapter_;  ///< ~input other than relative_measurement
   std::unique_ptr<FollowerOutputs> outputs_;
+  std::unique_ptr<MeasurementTrigger> trigger_;  ///< ~trigger measurement: a step per measurement
   std::unique_ptr<FollowerReconfigure> reconfigure_;
   std::unique_ptr<FollowerLoop> loop_;  ///< started last, stopped first
 };

@@ -10,13 +10,13 @@ namespace projection_collision_avoidance {
 
 FollowerInputs::FollowerInputs(std::string node_name, const FollowerNodeOptions& options,
                                const ControllerDesign& design, FollowerCycle* cycle,
-                               StepSink on_step)
+                               AcceptedSink on_accepted)
     : name_(std::move(node_name)),
       options_(options),
       design_(design),
       axes_(design.parameters.model.double_integrator_axes),
       cycle_(cycle),
-      on_step_(std::move(on_step)),
+      on_accepted_(std::move(on_accepted)),
       // A message older than its timeout on arrival could only be stale: refused as such.
       measurement_timeline_(
           "relative_measurement",
@@ -100,7 +100,7 @@ void FollowerInputs::admitMeasurement(const RelativeMeasurement& measurement) {
       return;
     }
     const std::int64_t raw = nanosecondsOf(msg->header.stamp);
-    // Measurement trigger: the periods between this stamp and the last accepted one's.
+    // The periods between this stamp and the last accepted one's (for the measurement trigger).
     const InputGuard& guard = timeline.guard();
     const std::uint32_t skipped =
         guard.haveAccepted()
@@ -112,12 +112,8 @@ void FollowerInputs::admitMeasurement(const RelativeMeasurement& measurement) {
     measurement_.sequence = guard.accepted();
     measurement_.relative_state = relative_state_;
     cycle_->measurement().write(measurement_);
-    if (options_.trigger == ControlTrigger::kMeasurement) {
-      // ROS time read again once the other inputs are latched (their callbacks may run on other
-      // threads): none of them counts as received after the step's time.
-      cycle_->stepOnMeasurement([] { return nanosecondsOf(ros::Time::now()); }, skipped,
-                                &trigger_output_);
-      on_step_(trigger_output_);
+    if (on_accepted_) {
+      on_accepted_(skipped);
     }
   });
   const std::string& rejection = timeline.guard().lastRejection();

@@ -49,18 +49,21 @@ struct FollowerInputStats {
 /// headway (time_headway > 0), `odom` (nav_msgs/Odometry: its own state; frame ~odom_frame,
 /// refused once older than ~measurement_timeout on arrival), judges each message with its
 /// InputTimeline (doc/boundary.md) on the subscriber's thread, and writes what it accepts into the
-/// control cycle's lock-free slots. With ~trigger measurement, each accepted measurement runs
-/// the cycle's step at once and hands its output to @p on_step. Nothing a message carries can
+/// control cycle's lock-free slots; each accepted measurement is then announced to @p on_accepted
+/// (with ~trigger measurement, MeasurementTrigger steps on it). Nothing a message carries can
 /// end the node (admitGuarded()). The subscriptions start with start().
 class FollowerInputs {
  public:
-  using StepSink = std::function<void(const FollowerCycleOutput&)>;
+  /// Told of each measurement written to the cycle, with the control periods skipped between its
+  /// stamp and the one accepted before it.
+  using AcceptedSink = std::function<void(std::uint32_t skipped)>;
 
   /// @param design the design at start: its model sizes and leader acceleration (pinv(B) u_d),
   ///        which reconfiguration does not change
   /// @param cycle where accepted inputs go; outlives this object
+  /// @param on_accepted told of each accepted measurement (may be empty: nobody is)
   FollowerInputs(std::string node_name, const FollowerNodeOptions& options,
-                 const ControllerDesign& design, FollowerCycle* cycle, StepSink on_step);
+                 const ControllerDesign& design, FollowerCycle* cycle, AcceptedSink on_accepted);
 
   /// Subscribes the inputs (once what the callbacks use is in place).
   void start(ros::NodeHandle nh);
@@ -91,14 +94,13 @@ class FollowerInputs {
                              ///< a_1) does not change by reconfiguration
   int axes_;
   FollowerCycle* cycle_;
-  StepSink on_step_;
+  AcceptedSink on_accepted_;
 
   // Subscriber threads only (one at a time per input: roscpp serialises a subscription), except
   // what each timeline lets other threads read (its age, skew and refusal count).
   InputTimeline measurement_timeline_;
   MeasurementSample measurement_;
   Eigen::VectorXd relative_state_;
-  FollowerCycleOutput trigger_output_;
   InputTimeline leader_timeline_;
   LeaderSample leader_;
   InputTimeline odometry_timeline_;

@@ -15,6 +15,7 @@
 #include "follower/FollowerOutputs.hpp"
 #include "follower/FollowerReconfigure.hpp"
 #include "follower/MeasurementAdapter.hpp"
+#include "follower/MeasurementTrigger.hpp"
 
 namespace projection_collision_avoidance {
 
@@ -56,12 +57,16 @@ FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh,
   cycle_ = std::make_unique<FollowerCycle>(std::move(controller), parameters.separation, settings);
   try {
     // The inputs subscribe once the outputs that a measurement's step uses are in place.
-    inputs_ = std::make_unique<FollowerInputs>(
-        name, options, start, cycle_.get(),
-        [this](const FollowerCycleOutput& out) { outputs_->publish(out); });
+    FollowerInputs::AcceptedSink on_accepted;
+    if (options.trigger == ControlTrigger::kMeasurement) {
+      on_accepted = [this](std::uint32_t skipped) { trigger_->onAccepted(skipped); };
+    }
+    inputs_ = std::make_unique<FollowerInputs>(name, options, start, cycle_.get(),
+                                               std::move(on_accepted));
     outputs_ =
         std::make_unique<FollowerOutputs>(nh, private_nh, name, options, parameters.control_rate,
                                           member, parameters.separation, inputs_.get());
+    trigger_ = std::make_unique<MeasurementTrigger>(cycle_.get(), outputs_.get());
     inputs_->start(nh);
     input_adapter_ = makeMeasurementAdapter(
         name, options, parameters.model.double_integrator_axes,
@@ -122,6 +127,7 @@ void FollowerNode::stop() {
   }
   input_adapter_.reset();
   inputs_.reset();  // no measurement's step after this
+  trigger_.reset();
   outputs_.reset();
 }
 
