@@ -1,6 +1,7 @@
-/// A bare roscpp relay, the baseline of the latency measurement (experiments/probes/latency.launch):
-/// subscribes `input` (RelativeMeasurement, queue 10, TCP_NODELAY) and republishes each message
-/// unchanged on `output`. Nothing else: no parameters, no checks, one thread (ros::spin()).
+/// A bare roscpp relay, the baseline of the latency measurement
+/// (experiments/probes/latency.launch): subscribes `input` (RelativeMeasurement, queue 10,
+/// TCP_NODELAY) and republishes each message unchanged on `output`. Nothing else: no parameters, no
+/// checks, one thread (ros::spin()).
 
 #include <ros/ros.h>
 

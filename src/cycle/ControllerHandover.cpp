@@ -22,7 +22,7 @@ std::unique_ptr<DynamicFollowerController> ControllerHandover::offer(
   if (!controller || controller->stateDimension() != controller_->stateDimension() ||
       controller->inputDimension() != controller_->inputDimension() ||
       controller->outputDimension() != controller_->outputDimension()) {
-    throw std::invalid_argument("FollowerCycle::offer: a controller of the same model sizes");
+    throw std::invalid_argument("ControllerHandover::offer: a controller of the same model sizes");
   }
   return std::unique_ptr<DynamicFollowerController>(offered_.exchange(controller.release()));
 }

@@ -1,5 +1,6 @@
-/// The fallback of a follower that has lost its measurement (FollowerController::step() without a measurement),
-/// its parameters, and the choice of mode from the ages of the inputs (selectFollowerMode()).
+/// The fallback of a follower that has lost its measurement (FollowerController::step() without a
+/// measurement), its parameters, and the choice of mode from the ages of the inputs
+/// (selectFollowerMode()).
 
 #include <cmath>
 #include <limits>

@@ -150,7 +150,8 @@ TEST(FollowerCycle, TheControlThreadAllocatesAndFreesNothing) {
       tick.index = static_cast<std::uint64_t>(k);
       tick.expected = tick.actual = now;
       tick.period = kMs;
-      cycle->tickOn(tick, [now] { return now; }, &out);
+      cycle->tickOn(
+          tick, [now] { return now; }, &out);
       outputs.post(out);
       std::this_thread::sleep_for(std::chrono::microseconds(50));
     }

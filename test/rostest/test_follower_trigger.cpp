@@ -1,5 +1,5 @@
-/// rostest: a follower with ~trigger measurement (test/rostest/follower_trigger.test). Parameters of
-/// the test node:
+/// rostest: a follower with ~trigger measurement (test/rostest/follower_trigger.test). Parameters
+/// of the test node:
 ///   ~measurements         how many measurements to publish, one at a time
 ///   ~control_rate         the follower's control rate (Hz)
 ///   ~measurement_timeout  the follower's ~measurement_timeout (s)

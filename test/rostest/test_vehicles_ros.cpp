@@ -1,5 +1,5 @@
-/// rostest: followers that are vehicles (test/rostest/vehicles.test, launch/vehicles.launch): each on
-/// ~input odometry, driving its robot through a command_adapter. Parameters of the test node:
+/// rostest: followers that are vehicles (test/rostest/vehicles.test, launch/vehicles.launch): each
+/// on ~input odometry, driving its robot through a command_adapter. Parameters of the test node:
 ///   ~followers           N
 ///   ~end_time            s of simulated time to watch (the push toward the followers included)
 ///   ~look_ahead          m, each follower's controlled point ahead of its axle (0: holonomic)
