@@ -33,13 +33,21 @@ set(PCA_SIM_SOURCES
   src/sim/VehicleModels.cpp
 )
 
-# projection_collision_avoidance_scenario: scenario files (libyaml parses them into yaml-cpp
-# trees) and the cf_sim command.
+# projection_collision_avoidance_configuration: a follower's configuration (the model, controller
+# and formation sections of a scenario file; libyaml parses the file into a yaml-cpp tree); the
+# core and the YAML libraries only.
+set(PCA_CONFIGURATION_SOURCES
+  src/configuration/ConfigurationLoader.cpp
+  src/configuration/ConfigurationSections.cpp
+  src/configuration/ControllerReader.cpp
+  src/configuration/YamlParser.cpp
+)
+
+# projection_collision_avoidance_scenario: whole scenario files (the simulation's sections too,
+# read with the configuration library's) and the cf_sim command.
 set(PCA_SCENARIO_SOURCES
   src/scenario/CfSimApp.cpp
-  src/scenario/ControllerReader.cpp
   src/scenario/ScenarioLoader.cpp
-  src/scenario/YamlParser.cpp
 )
 
 # projection_collision_avoidance_vehicle: the vehicle adapters' math (odometry pairs to a relative

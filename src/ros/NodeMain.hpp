@@ -6,8 +6,8 @@
 
 #include <ros/ros.h>
 
+#include "projection_collision_avoidance/configuration/ConfigurationLoader.hpp"
 #include "projection_collision_avoidance/core/ParameterError.hpp"
-#include "projection_collision_avoidance/scenario/ScenarioLoader.hpp"
 
 namespace projection_collision_avoidance {
 

@@ -7,8 +7,8 @@
 #include <ros/console.h>
 #include <ros/init.h>
 
+#include "projection_collision_avoidance/configuration/ConfigurationLoader.hpp"
 #include "projection_collision_avoidance/core/ParameterError.hpp"
-#include "projection_collision_avoidance/scenario/ScenarioLoader.hpp"
 
 namespace projection_collision_avoidance {
 namespace {
@@ -104,13 +104,18 @@ YAML::Node toYamlAt(const XmlRpc::XmlRpcValue& value, const std::string& path, s
   }
 }
 
-/// True once the node is shutting down (SIGINT, rosnode kill, ros::shutdown()): ends a scenario
-/// load that is still parsing. Before ros::spin() too: roscpp's poll thread turns the SIGINT
-/// into ros::shutdown(), which clears ros::ok().
-bool shuttingDown() { return !ros::ok() || ros::isShuttingDown(); }
+}  // namespace
 
-Scenario loadScenarioAt(const ros::NodeHandle& private_nh, const std::string& name,
-                        const ScenarioLoadOptions& options) {
+YAML::Node toYaml(const XmlRpc::XmlRpcValue& value) {
+  Conversion conversion;
+  return toYamlAt(value, "", 1, &conversion);
+}
+
+bool nodeShuttingDown() { return !ros::ok() || ros::isShuttingDown(); }
+
+void readScenarioParameter(const ros::NodeHandle& private_nh, const std::string& name,
+                           const std::function<void(const std::string& path)>& from_file,
+                           const std::function<void(const YAML::Node& tree)>& from_tree) {
   XmlRpc::XmlRpcValue value;
   if (!private_nh.getParam(name, value)) {
     throw ParameterError("~" + name,
@@ -120,12 +125,12 @@ Scenario loadScenarioAt(const ros::NodeHandle& private_nh, const std::string& na
   }
   try {
     if (value.getType() == XmlRpc::XmlRpcValue::TypeString) {
-      return loadScenarioFile(static_cast<std::string>(value), {}, options);
-    }
-    if (value.getType() != XmlRpc::XmlRpcValue::TypeStruct) {
+      from_file(static_cast<std::string>(value));
+    } else if (value.getType() == XmlRpc::XmlRpcValue::TypeStruct) {
+      from_tree(toYaml(value));
+    } else {
       throw ParameterError("", "must be a map or a file path, got " + typeName(value));
     }
-    return scenarioFromYaml(toYaml(value), {}, options);
   } catch (const ParameterError& error) {
     throw ParameterError(parameterName(name, error.key()), error.reason());
   } catch (const ScenarioLoadCancelled& cancelled) {
@@ -133,26 +138,13 @@ Scenario loadScenarioAt(const ros::NodeHandle& private_nh, const std::string& na
   }
 }
 
-}  // namespace
-
-YAML::Node toYaml(const XmlRpc::XmlRpcValue& value) {
-  Conversion conversion;
-  return toYamlAt(value, "", 1, &conversion);
-}
-
-Scenario loadScenarioParameter(const ros::NodeHandle& private_nh, const std::string& name) {
-  ScenarioLoadOptions options;
-  options.cancelled = shuttingDown;
-  return loadScenarioAt(private_nh, name, options);
-}
-
-void requireNodeScenario(const Scenario& scenario) {
-  if (!scenario.controller.model.isDoubleIntegrator()) {
+void requireNodeController(const ControllerParameters& controller) {
+  if (!controller.model.isDoubleIntegrator()) {
     throw ParameterError("model.type",
                          "the ROS nodes run double_integrator models (relative position and "
                          "velocity); use cf_sim for a linear model");
   }
-  const double rate = scenario.controller.control_rate;
+  const double rate = controller.control_rate;
   if (!(rate >= kMinNodeRate && rate <= kMaxNodeRate)) {
     std::ostringstream reason;
     reason << "the ROS nodes run at " << kMinNodeRate << " to " << kMaxNodeRate << " Hz, got "
@@ -161,11 +153,23 @@ void requireNodeScenario(const Scenario& scenario) {
   }
 }
 
-Scenario loadDoubleIntegratorScenario(const ros::NodeHandle& private_nh, const std::string& name) {
-  ScenarioLoadOptions options;
-  options.cancelled = shuttingDown;
-  options.check = requireNodeScenario;
-  return loadScenarioAt(private_nh, name, options);
+FollowerConfiguration loadFollowerConfiguration(const ros::NodeHandle& private_nh,
+                                                const std::string& name) {
+  ConfigurationLoadOptions options;
+  options.cancelled = nodeShuttingDown;
+  options.check = [](const FollowerConfiguration& configuration) {
+    requireNodeController(configuration.controller);
+  };
+  FollowerConfiguration configuration;
+  readScenarioParameter(
+      private_nh, name,
+      [&](const std::string& path) {
+        configuration = loadFollowerConfigurationFile(path, {}, options);
+      },
+      [&](const YAML::Node& tree) {
+        configuration = followerConfigurationFromYaml(tree, {}, options);
+      });
+  return configuration;
 }
 
 bool NodeOptionReader::lookup(const std::string& key, XmlRpc::XmlRpcValue* value) const {

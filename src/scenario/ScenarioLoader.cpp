@@ -2,10 +2,8 @@
 
 #include <cmath>
 #include <cstddef>
-#include <exception>
-#include <set>
-#include <sstream>
-#include <stdexcept>
+#include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -14,101 +12,13 @@
 #include "projection_collision_avoidance/core/ControllerDesign.hpp"
 #include "projection_collision_avoidance/core/ParameterError.hpp"
 
+#include "ConfigurationSections.hpp"
 #include "ControllerReader.hpp"
 #include "YamlParser.hpp"
 #include "YamlReader.hpp"
 
 namespace projection_collision_avoidance {
 namespace {
-
-/// Sets the entry at path[index..] below @p node. Recurses once per path element of an
-/// override ("a.b.0.c"), so the depth is bounded by the length of a command-line key; the
-/// scenario loader runs at start-up, never in a control step.
-// NOLINTNEXTLINE(misc-no-recursion)
-void setAtPath(YAML::Node node, const std::vector<std::string>& path, std::size_t index,
-               const YAML::Node& value, const std::string& full_key) {
-  const std::string& element = path[index];
-  const bool last = index + 1 == path.size();
-  if (node.IsSequence()) {
-    std::size_t position = 0;
-    try {
-      std::size_t consumed = 0;
-      position = std::stoul(element, &consumed);
-      if (consumed != element.size()) {
-        throw std::invalid_argument(element);
-      }
-    } catch (const std::exception&) {
-      throw ParameterError(full_key, "'" + element + "' is not an index into a list");
-    }
-    if (position >= node.size()) {
-      throw ParameterError(full_key, "index " + element + " is past the end of the list");
-    }
-    if (last) {
-      node[position] = value;
-    } else {
-      setAtPath(node[position], path, index + 1, value, full_key);
-    }
-    return;
-  }
-  if (!node.IsMap() && !node.IsNull()) {
-    throw ParameterError(full_key, "'" + element + "' is below a value that is not a map");
-  }
-  if (last) {
-    node[element] = value;
-    return;
-  }
-  if (!node[element].IsDefined() || node[element].IsNull()) {
-    node[element] = YAML::Node(YAML::NodeType::Map);  // create the missing level
-  }
-  setAtPath(node[element], path, index + 1, value, full_key);
-}
-
-void applyOverride(YAML::Node& root, const std::string& assignment) {
-  const std::size_t equals = assignment.find('=');
-  if (equals == std::string::npos || equals == 0) {
-    throw ParameterError(assignment, "an override reads key=value");
-  }
-  const std::string key = assignment.substr(0, equals);
-  std::vector<std::string> path;
-  std::stringstream stream(key);
-  for (std::string element; std::getline(stream, element, '.');) {
-    if (element.empty()) {
-      throw ParameterError(key, "has an empty path element");
-    }
-    path.push_back(element);
-  }
-  YAML::Node value;
-  try {
-    value = detail::parseYaml(assignment.substr(equals + 1));
-  } catch (const ParameterError& error) {
-    throw ParameterError(key, "in the value: " + error.reason());
-  }
-  setAtPath(root, path, 0, value, key);
-}
-
-AgentModel readModel(detail::YamlReader& reader) {
-  detail::YamlReader model = reader.map("model");
-  const std::string type = model.string("type");
-  AgentModel result;
-  if (type == "double_integrator") {
-    result = makeDoubleIntegrator(model.integer("dimension"));
-  } else if (type == "linear") {
-    const Eigen::MatrixXd A = model.matrix("A", -1, -1);
-    result.A = A;
-    result.B = model.matrix("B", A.rows(), -1);
-    result.C = Eigen::MatrixXd::Identity(A.rows(), A.rows());
-    result.position_dimension = model.integer("position_dimension");
-  } else {
-    throw ParameterError(model.key("type"),
-                         "must be double_integrator or linear, got '" + type + "'");
-  }
-  if (model.has("C")) {
-    result.C = model.matrix("C", -1, result.A.rows());
-  }
-  model.finish();
-  validateAgentModel(result);
-  return result;
-}
 
 /// The pulses of the list @p name; each is checked against @p size entries, so that an error
 /// names the entry by its path in the file ("leader.disturbance.0.vector").
@@ -170,12 +80,40 @@ SignalProfile readInputProfile(detail::YamlReader& leader, Eigen::Index size) {
   return profile;
 }
 
+/// controller.leader_information.link: each key optional (0 by default).
+LinkSpec readLink(detail::YamlReader& sharing) {
+  detail::YamlReader section = sharing.map("link");
+  LinkSpec link;
+  link.configured = true;
+  if (section.has("delay_periods")) {
+    link.delay_periods = section.integer("delay_periods");
+  }
+  if (section.has("latency")) {
+    link.latency = section.number("latency");
+  }
+  if (section.has("dropout")) {
+    link.dropout = section.number("dropout");
+  }
+  if (section.has("seed")) {
+    const int seed = section.integer("seed");
+    if (seed < 0) {
+      throw ParameterError(section.key("seed"),
+                           "must be a whole number >= 0, got " + std::to_string(seed));
+    }
+    link.seed = static_cast<std::uint64_t>(seed);
+  }
+  section.finish();
+  link.validate(std::numeric_limits<double>::quiet_NaN());  // ranges; the delay with the rate later
+  return link;
+}
+
 /// Reads every key, runs the per-key checks, then @p check, then the design's derived checks.
 Scenario readScenario(const YAML::Node& root, const ScenarioLoadOptions& options) {
   detail::YamlReader reader(root, "");
   Scenario scenario;
-  const AgentModel model = readModel(reader);
-  scenario.controller = detail::readController(reader, model, &scenario.link);
+  const AgentModel model = detail::readModel(reader);
+  scenario.controller = detail::readController(
+      reader, model, [&](detail::YamlReader& sharing) { scenario.link = readLink(sharing); });
 
   detail::YamlReader leader = reader.map("leader");
   scenario.leader_initial_state = leader.vector("initial_state");
@@ -193,23 +131,7 @@ Scenario readScenario(const YAML::Node& root, const ScenarioLoadOptions& options
   scenario.duration = simulation.number("duration");
   simulation.finish();
 
-  if (reader.has("formation")) {
-    detail::YamlReader formation = reader.map("formation");
-    FormationSpec& spec = scenario.formation;
-    spec.configured = true;
-    spec.followers = formation.integer("followers");
-    if (formation.has("topology")) {
-      spec.topology =
-          parseFormationTopology(formation.string("topology"), formation.key("topology"));
-    }
-    if (formation.has("shape")) {
-      spec.shape = parseFormationShape(formation.string("shape"), formation.key("shape"));
-    }
-    if (formation.has("half_angle")) {
-      spec.half_angle = formation.number("half_angle");
-    }
-    formation.finish();
-  }
+  scenario.formation = detail::readFormation(reader);
   reader.finish();
 
   scenario.validate();
@@ -220,19 +142,10 @@ Scenario readScenario(const YAML::Node& root, const ScenarioLoadOptions& options
   return scenario;
 }
 
-Scenario parseRoot(YAML::Node root, const std::vector<std::string>& overrides,
+Scenario parseRoot(const YAML::Node& root, const std::vector<std::string>& overrides,
                    const ScenarioLoadOptions& options) {
-  if (!root.IsMap()) {
-    throw ParameterError("(root)", "a scenario is a YAML map");
-  }
-  try {
-    for (const std::string& assignment : overrides) {
-      applyOverride(root, assignment);
-    }
-    return readScenario(root, options);
-  } catch (const YAML::Exception& error) {  // every read names its key; this is a safety net
-    throw ParameterError("(root)", std::string("cannot be read: ") + error.what());
-  }
+  return detail::readRoot(root, overrides,
+                          [&](const YAML::Node& tree) { return readScenario(tree, options); });
 }
 
 }  // namespace

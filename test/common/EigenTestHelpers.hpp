@@ -18,8 +18,9 @@ template <typename A, typename B>
 ::testing::AssertionResult matricesNear(const char* a_expr, const char* b_expr, const char*,
                                         const Eigen::MatrixBase<A>& a,
                                         const Eigen::MatrixBase<B>& b, double tolerance) {
+  // Two empty matrices of one shape are equal (maxCoeff() of an empty one is undefined).
   if (a.rows() == b.rows() && a.cols() == b.cols() &&
-      ((a - b).cwiseAbs().maxCoeff() <= tolerance)) {
+      (a.size() == 0 || (a - b).cwiseAbs().maxCoeff() <= tolerance)) {
     return ::testing::AssertionSuccess();
   }
   std::ostringstream message;

@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 #include <xmlrpcpp/XmlRpcValue.h>
 
+#include "projection_collision_avoidance/configuration/ConfigurationLoader.hpp"
 #include "projection_collision_avoidance/core/ParameterError.hpp"
 #include "projection_collision_avoidance/ros/RosParameters.hpp"
 #include "projection_collision_avoidance/scenario/ScenarioLoader.hpp"
@@ -25,17 +26,39 @@ std::string paperText() {
   return text.str();
 }
 
-/// The ParameterError of loading the paper's Run 2 with @p overrides under the nodes' checks.
-ParameterError nodeRefusal(const std::vector<std::string>& overrides) {
+ScenarioLoadOptions nodeScenarioOptions() {
   ScenarioLoadOptions options;
-  options.check = requireNodeScenario;
+  options.check = [](const Scenario& scenario) { requireNodeController(scenario.controller); };
+  return options;
+}
+
+ConfigurationLoadOptions nodeConfigurationOptions() {
+  ConfigurationLoadOptions options;
+  options.check = [](const FollowerConfiguration& configuration) {
+    requireNodeController(configuration.controller);
+  };
+  return options;
+}
+
+/// The ParameterError of loading the paper's Run 2 with @p overrides under the nodes' checks, as
+/// the simulation nodes load it (the whole scenario) and as a follower does (its configuration):
+/// the two name the same key, which is returned.
+ParameterError nodeRefusal(const std::vector<std::string>& overrides) {
+  ParameterError scenario_error("", "");
   try {
-    parseScenario(paperText(), overrides, options);
+    parseScenario(paperText(), overrides, nodeScenarioOptions());
+    ADD_FAILURE() << "the scenario was accepted";
   } catch (const ParameterError& error) {
-    return error;
+    scenario_error = error;
   }
-  ADD_FAILURE() << "accepted";
-  return {"", ""};
+  try {
+    parseFollowerConfiguration(paperText(), overrides, nodeConfigurationOptions());
+    ADD_FAILURE() << "the follower's configuration was accepted";
+  } catch (const ParameterError& error) {
+    EXPECT_EQ(error.key(), scenario_error.key()) << error.what();
+    EXPECT_EQ(error.reason(), scenario_error.reason()) << error.what();
+  }
+  return scenario_error;
 }
 
 TEST(NodeScenario, NamesTheControlRateTheUserWrote) {
@@ -45,11 +68,10 @@ TEST(NodeScenario, NamesTheControlRateTheUserWrote) {
     EXPECT_EQ(error.key(), "controller.control_rate") << error.what();
     EXPECT_NE(error.reason().find("the ROS nodes run at"), std::string::npos) << error.what();
   }
-  ScenarioLoadOptions options;
-  options.check = requireNodeScenario;
   for (const double rate : {kMinNodeRate * 100.0, kMaxNodeRate}) {
-    EXPECT_NO_THROW(
-        parseScenario(paperText(), {"controller.control_rate=" + std::to_string(rate)}, options));
+    const std::vector<std::string> overrides{"controller.control_rate=" + std::to_string(rate)};
+    EXPECT_NO_THROW(parseScenario(paperText(), overrides, nodeScenarioOptions()));
+    EXPECT_NO_THROW(parseFollowerConfiguration(paperText(), overrides, nodeConfigurationOptions()));
   }
 }
 

@@ -25,7 +25,7 @@
 
 #include "projection_collision_avoidance/core/ControllerDesign.hpp"
 #include "projection_collision_avoidance/ros/MessageConversions.hpp"
-#include "projection_collision_avoidance/ros/RosParameters.hpp"
+#include "projection_collision_avoidance/ros/ScenarioParameters.hpp"
 
 #include "test_common.h"
 

@@ -35,7 +35,7 @@
 
 #include "projection_collision_avoidance/core/ControllerDesign.hpp"
 #include "projection_collision_avoidance/core/Formation.hpp"
-#include "projection_collision_avoidance/ros/RosParameters.hpp"
+#include "projection_collision_avoidance/ros/ScenarioParameters.hpp"
 #include "projection_collision_avoidance/sim/SampledSimulator.hpp"
 
 #include "test_common.h"

@@ -120,7 +120,19 @@ def then(*changes):
 Case = collections.namedtuple("Case", "name key change scenario options nodes")
 
 
-def case(name, key, change=None, scenario=None, options=None, nodes=ALL_NODES):
+# The sections of a scenario that only the simulation reads: the follower reads its own (model,
+# controller, formation) alone and starts whatever these hold (configuration/ConfigurationLoader).
+SIMULATION_SECTIONS = ("~scenario/leader", "~scenario/follower", "~scenario/simulation",
+                       "~scenario/controller/leader_information/link")
+SIMULATION_NODES = (PLANT, LEADER)
+
+
+def case(name, key, change=None, scenario=None, options=None, nodes=None):
+    """A run of each node of NODES (default: those that read KEY; every node when KEY is None)."""
+    if nodes is None:
+        reads_simulation = key is not None and any(
+            key == section or key.startswith(section + "/") for section in SIMULATION_SECTIONS)
+        nodes = SIMULATION_NODES if reads_simulation else ALL_NODES
     return Case(name, key, change, scenario, options or {}, nodes)
 
 
@@ -143,7 +155,7 @@ FILES = {
     "slow_rate.yaml": None,  # the paper's file with control_rate: 0.999
 }
 
-# The limits of scenario files (ScenarioLoader.hpp: kMaxScenarioBytes, kMaxScenarioDepth).
+# The limits of scenario files (ConfigurationLoader.hpp: kMaxScenarioBytes, kMaxScenarioDepth).
 MAX_BYTES = 1 << 20
 MAX_DEPTH = 64
 
@@ -986,6 +998,12 @@ class InvalidParameters(unittest.TestCase):
         cases = [case("integers", None, scenario=integers, options=options[node], nodes=(node,))
                  for node in ALL_NODES]
         cases.append(case("2-D", None, scenario=planar))
+        # The follower reads its own sections alone: without the simulation's it starts.
+        followers_alone = paper_scenario()
+        for section in ("leader", "follower", "simulation"):
+            del followers_alone[section]
+        cases.append(case("the follower's sections alone", None, scenario=followers_alone,
+                          nodes=(FOLLOWER,)))
         cases.append(case("file path", None, scenario=paper_path()))
         for trigger in ("timer", "measurement"):
             cases.append(case("trigger " + trigger, None, options={"trigger": trigger},

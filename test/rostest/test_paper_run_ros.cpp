@@ -13,7 +13,7 @@
 #include <ros/ros.h>
 
 #include "projection_collision_avoidance/core/ControllerDesign.hpp"
-#include "projection_collision_avoidance/ros/RosParameters.hpp"
+#include "projection_collision_avoidance/ros/ScenarioParameters.hpp"
 #include "projection_collision_avoidance/sim/SampledSimulator.hpp"
 
 #include "test_common.h"

@@ -1,10 +1,12 @@
 #pragma once
 
 /// @file
-/// Reading a node's private parameters: the scenario (the same YAML as cf_sim) and the node's
-/// own options. Every failure is a ParameterError whose key is the parameter's name
+/// Reading a node's private parameters: the follower's configuration (the scenario file of
+/// cf_sim; the simulation nodes read all of it through ScenarioParameters.hpp) and the node's own
+/// options. Every failure is a ParameterError whose key is the parameter's name
 /// ("~scenario/controller/alpha", "~measurement_timeout").
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -12,8 +14,9 @@
 #include <xmlrpcpp/XmlRpcValue.h>
 #include <yaml-cpp/yaml.h>
 
+#include "projection_collision_avoidance/core/ControllerParameters.hpp"
+#include "projection_collision_avoidance/core/FollowerConfiguration.hpp"
 #include "projection_collision_avoidance/cycle/StampCorrection.hpp"
-#include "projection_collision_avoidance/sim/Scenario.hpp"
 
 namespace projection_collision_avoidance {
 
@@ -25,33 +28,42 @@ constexpr double kMaxNodeRate = 10000.0;
 /// The same tree as YAML: structs become maps, arrays sequences, scalars scalars. A string
 /// becomes a scalar tagged as a string (like a quoted one), which the scenario loader does not
 /// take for a number or a boolean. The limits of scenario files apply (kMaxScenarioDepth,
-/// kMaxScenarioNodes of ScenarioLoader.hpp; the root counts as depth 1, a key as a node).
+/// kMaxScenarioNodes of ConfigurationLoader.hpp; the root counts as depth 1, a key as a node).
 /// @throws ParameterError (key: the entry's dotted path) for binary data, a date, a list or map
 ///         nested deeper than kMaxScenarioDepth, or the node beyond kMaxScenarioNodes
 YAML::Node toYaml(const XmlRpc::XmlRpcValue& value);
 
-/// Loads the scenario from the private parameter @p name: either a map (the scenario file loaded
-/// with `<rosparam command="load" file="..." ns="scenario"/>` inside the node) or a string, the
-/// path of a scenario file. Errors name "~<name>/<dotted/path>". Parsing a file stops once the
-/// node shuts down (SIGINT, also before ros::spin(), or ros::shutdown()).
-/// @throws ParameterError for an invalid scenario or one beyond the limits of scenario files
-/// @throws ScenarioLoadCancelled ("~<name>: loading cancelled at ...") when the node shut down
-///         while the file was parsed
-Scenario loadScenarioParameter(const ros::NodeHandle& private_nh,
-                               const std::string& name = "scenario");
+/// Runs @p from_file on the path, or @p from_tree on the map, that the private parameter @p name
+/// holds: a scenario file's path, or the file loaded with `<rosparam command="load"
+/// file="..." ns="scenario"/>` inside the node (converted by toYaml()). A ParameterError of
+/// theirs is renamed "~<name>/<dotted/path>", a ScenarioLoadCancelled "~<name>: ...".
+/// @throws ParameterError when the parameter is missing or neither a string nor a map
+void readScenarioParameter(const ros::NodeHandle& private_nh, const std::string& name,
+                           const std::function<void(const std::string& path)>& from_file,
+                           const std::function<void(const YAML::Node& tree)>& from_tree);
 
-/// The ROS nodes' own requirements of a scenario (ROS-free): a double_integrator model, since
+/// True once the node is shutting down (SIGINT, rosnode kill, ros::shutdown()): the predicate
+/// that ends a scenario load still parsing. Before ros::spin() too: roscpp's poll thread turns
+/// the SIGINT into ros::shutdown(), which clears ros::ok().
+bool nodeShuttingDown();
+
+/// The ROS nodes' own requirements of a controller (ROS-free): a double_integrator model, since
 /// the nodes exchange relative positions and velocities, and a control rate in
 /// [kMinNodeRate, kMaxNodeRate].
 /// @throws ParameterError with the dotted key "model.type" or "controller.control_rate"
-void requireNodeScenario(const Scenario& scenario);
+void requireNodeController(const ControllerParameters& controller);
 
-/// As loadScenarioParameter(), with requireNodeScenario() run before the controller design's
-/// derived checks, so that a model or a rate the nodes refuse is named
-/// ("~<name>/model/type", "~<name>/controller/control_rate") rather than a gain or
-/// "estimator/substeps" that the design derives from it.
-Scenario loadDoubleIntegratorScenario(const ros::NodeHandle& private_nh,
-                                      const std::string& name = "scenario");
+/// A follower's configuration (configuration/ConfigurationLoader.hpp: the model, controller and
+/// formation sections) from the private parameter @p name, as readScenarioParameter() reads it,
+/// with requireNodeController() run before the controller design's derived checks, so that a
+/// model or a rate the nodes refuse is named ("~<name>/model/type",
+/// "~<name>/controller/control_rate") rather than a gain or "estimator/substeps" that the design
+/// derives from it. Parsing a file stops once the node shuts down.
+/// @throws ParameterError for an invalid configuration or one beyond the limits of scenario files
+/// @throws ScenarioLoadCancelled ("~<name>: loading cancelled at ...") when the node shut down
+///         while the file was parsed
+FollowerConfiguration loadFollowerConfiguration(const ros::NodeHandle& private_nh,
+                                                const std::string& name = "scenario");
 
 /// Reads a node's own private options, checks each once, and remembers them for echo().
 class NodeOptionReader {

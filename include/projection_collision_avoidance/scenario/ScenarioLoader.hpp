@@ -1,40 +1,24 @@
 #pragma once
 
 /// @file
-/// Reads the YAML scenario format of doc/cf_sim.md, "Scenario files" (yaml-cpp). Every error is a
-/// ParameterError whose key is the dotted path of the offending entry.
+/// Reads the YAML scenario format of doc/cf_sim.md, "Scenario files" (yaml-cpp): every section,
+/// the simulation's with the follower's (configuration/ConfigurationLoader.hpp reads the
+/// follower's alone). Every error is a ParameterError whose key is the dotted path of the
+/// offending entry. The limits (kMaxScenarioBytes, ...) and ScenarioLoadCancelled are those of
+/// ConfigurationLoader.hpp.
 
-#include <cstddef>
 #include <functional>
-#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include <yaml-cpp/yaml.h>
 
+#include "projection_collision_avoidance/configuration/ConfigurationLoader.hpp"
 #include "projection_collision_avoidance/sim/Scenario.hpp"
 
 namespace projection_collision_avoidance {
 
-// Limits on a scenario's YAML, checked while it is read (doc/cf_sim.md, "Limits"). The largest
-// scenario of config/scenarios has under 2 KB, about 100 nodes, and lists and maps nested 6
-// deep; a formation of any size is one number (formation.followers).
-
-/// Bytes of a scenario file (or text): 1 MiB.
-constexpr std::size_t kMaxScenarioBytes = std::size_t{1} << 20U;
-/// Lists and maps nested in one another, the root counting as 1.
-constexpr std::size_t kMaxScenarioDepth = 64;
-/// Nodes of the tree (scalars, lists, maps, keys included), an alias counting as every node it
-/// repeats: at most about 55 MB of yaml-cpp tree.
-constexpr std::size_t kMaxScenarioNodes = 100000;
-
-/// A load ended by its cancellation predicate (ScenarioLoadOptions::cancelled).
-class ScenarioLoadCancelled : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
-
-/// What a caller adds to a load.
+/// What a caller adds to a load of a scenario.
 struct ScenarioLoadOptions {
   /// Polled while the YAML is parsed (before the first event and then every few hundred); once
   /// it returns true, the load ends with ScenarioLoadCancelled. Empty: never cancelled.

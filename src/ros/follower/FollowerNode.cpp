@@ -20,8 +20,7 @@
 namespace projection_collision_avoidance {
 
 FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
-    : FollowerNode(nh, private_nh,
-                   loadDoubleIntegratorScenario(private_nh).followerConfiguration()) {}
+    : FollowerNode(nh, private_nh, loadFollowerConfiguration(private_nh)) {}
 
 FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh,
                            const FollowerConfiguration& configuration) {

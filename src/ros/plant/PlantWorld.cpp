@@ -18,6 +18,7 @@
 #include "projection_collision_avoidance/core/Formation.hpp"
 #include "projection_collision_avoidance/core/ParameterError.hpp"
 #include "projection_collision_avoidance/ros/MessageConversions.hpp"
+#include "projection_collision_avoidance/ros/ScenarioParameters.hpp"
 
 namespace projection_collision_avoidance {
 namespace {

@@ -1,8 +1,6 @@
 #include "ControllerReader.hpp"
 
 #include <cmath>
-#include <cstdint>
-#include <limits>
 #include <string>
 
 #include <Eigen/Core>
@@ -49,36 +47,10 @@ Eigen::MatrixXd readGain(YamlReader& section, const AgentModel& model) {
   return doubleIntegratorGain(omega, zeta, section.key("natural_frequency"));
 }
 
-/// controller.leader_information.link: each key optional (0 by default).
-LinkSpec readLink(YamlReader& sharing) {
-  YamlReader section = sharing.map("link");
-  LinkSpec link;
-  link.configured = true;
-  if (section.has("delay_periods")) {
-    link.delay_periods = section.integer("delay_periods");
-  }
-  if (section.has("latency")) {
-    link.latency = section.number("latency");
-  }
-  if (section.has("dropout")) {
-    link.dropout = section.number("dropout");
-  }
-  if (section.has("seed")) {
-    const int seed = section.integer("seed");
-    if (seed < 0) {
-      throw ParameterError(section.key("seed"),
-                           "must be a whole number >= 0, got " + std::to_string(seed));
-    }
-    link.seed = static_cast<std::uint64_t>(seed);
-  }
-  section.finish();
-  link.validate(std::numeric_limits<double>::quiet_NaN());  // ranges; the delay with the rate later
-  return link;
-}
-
 }  // namespace
 
-ControllerParameters readController(YamlReader& reader, const AgentModel& model, LinkSpec* link) {
+ControllerParameters readController(YamlReader& reader, const AgentModel& model,
+                                    const LinkSectionReader& read_link) {
   const Eigen::Index n = model.stateDimension();
   const Eigen::Index m = model.inputDimension();
   const Eigen::Index p = model.outputDimension();
@@ -164,8 +136,8 @@ ControllerParameters readController(YamlReader& reader, const AgentModel& model,
       }
       feedforward.finish();
     }
-    if (sharing.has("link")) {
-      *link = readLink(sharing);
+    if (sharing.has("link") && read_link) {
+      read_link(sharing);
     }
     sharing.finish();
   }

@@ -1,7 +1,8 @@
 #pragma once
 
 /// @file
-/// Typed, key-tracking access to one YAML map of a scenario (internal to the scenario library).
+/// Typed, key-tracking access to one YAML map of a scenario (internal to the configuration
+/// library).
 /// Every read marks its key as known; finish() refuses the keys nobody read.
 
 #include <cmath>
@@ -39,6 +40,10 @@ class YamlReader {
     used_.insert(name);
     return !node[name].IsNull();
   }
+
+  /// Marks the entry as known without reading it: a section that another reader reads (the
+  /// simulation's sections, when only a follower's configuration is read).
+  void skip(const std::string& name) { used_.insert(name); }
 
   YamlReader map(const std::string& name) {
     const YAML::Node child = required(name);

@@ -3,6 +3,7 @@
 #include <exception>
 
 #include "projection_collision_avoidance/ros/RosParameters.hpp"
+#include "projection_collision_avoidance/ros/ScenarioParameters.hpp"
 
 namespace projection_collision_avoidance {
 

@@ -1,14 +1,14 @@
 #pragma once
 
 /// @file
-/// YAML text to a yaml-cpp tree through libyaml's event parser (internal to the scenario
+/// YAML text to a yaml-cpp tree through libyaml's event parser (internal to the configuration
 /// library). yaml-cpp's own scanner costs over a thousand instructions per byte, most of cf_sim's
 /// start-up; libyaml parses the same text in a small fraction of that. The tree is the one
 /// YAML::Load() builds: plain scalars tagged "?", quoted and block scalars "!", explicit tags
 /// resolved ("!!str" is tag:yaml.org,2002:str), an untagged plain "", "~", "null", "Null" or
 /// "NULL" a null node, aliases sharing their anchor's node.
 ///
-/// The limits of ScenarioLoader.hpp (kMaxScenarioBytes, kMaxScenarioDepth, kMaxScenarioNodes)
+/// The limits of ConfigurationLoader.hpp (kMaxScenarioBytes, kMaxScenarioDepth, kMaxScenarioNodes)
 /// are checked while the file is read and the events arrive, so that a refused text costs no
 /// more than the limits.
 
