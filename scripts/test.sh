@@ -6,13 +6,14 @@
 #     alone are RUN_SERIAL); then the multi-host cases of test/multihost/run_all.sh (network
 #     namespaces, root only, two at a time); all read back with catkin_test_results;
 #  2. beside all that, at the lowest CPU priority (nice 19: the installation, the colcon build
-#     and a test that waits on the clock get the processor when they want it; these builds take
-#     what is left): the sanitizer build, started once its packages are installed (the rest of
-#     the installation keeps dpkg busy on one core), then, once the colcon build is done, the
-#     other two routes, catkin_make and catkin build, each in a fresh workspace; every workspace
-#     sourced and used as README says (scripts/check_workspace.sh);
-#  3. on a quiet machine again, scripts/sanitize.sh: the core gtests under ASan + UBSan (clang,
-#     standalone CMake project) and a short libFuzzer run ($SANITIZE_FUZZ_SECONDS, default 25 s).
+#     and a test that waits on the clock get the processor when they want it; this work takes
+#     what is left), one after another: the sanitizer build, started once its packages are
+#     installed (the rest of the installation keeps dpkg busy on one core); scripts/sanitize.sh's
+#     tests, the core gtests under ASan + UBSan (clang, standalone CMake project) and a short
+#     libFuzzer run ($SANITIZE_FUZZ_SECONDS, default 25 s); then, once the colcon build is done,
+#     the other two routes, catkin_make and catkin build, each in a fresh workspace; every
+#     workspace sourced and used as README says (scripts/check_workspace.sh);
+#  3. the results of both, once both are done.
 # The workspaces lie side by side in $TEST_BUILD_DIR (default: a new folder in $TMPDIR or /tmp),
 # each built by scripts/workspace.sh through one ccache: what the first compiled, the others find.
 # Each phase starts with a line "== phase NAME (at S s)", S the seconds since the first; those of
@@ -80,6 +81,12 @@ beside_the_tests() {
   # workspaces' hits).
   CCACHE_DIR=$(ccache -k cache_dir)-sanitize SANITIZE_BUILD_DIR=$sanitize_dir \
     "$root/scripts/sanitize.sh" --build-only
+  # Its gtests and the fuzzing need no quiet machine either: nothing in them reads a clock.
+  SANITIZE_BUILD_DIR=$sanitize_dir "$root/scripts/sanitize.sh" --no-build \
+    --fuzz-seconds "$fuzz_seconds" || {
+    echo "test: scripts/sanitize.sh failed (sanitizer tests or fuzzing)"
+    return 1
+  }
   # The other two routes find in the cache what the colcon build compiled.
   phase "waiting for the colcon build"
   while [[ ! -e $colcon_built ]]; do sleep 1; done
@@ -131,21 +138,17 @@ if [[ $results_ok != true || $failed -ne 0 || $passed -eq 0 ]]; then
   exit 1
 fi
 
-phase "waiting for the builds beside the tests"
+phase "waiting for the work beside the tests"
 beside_status=0
 wait "$beside_pid" || beside_status=$?
 beside_pid=
 cat "$beside_log"
 if [[ $beside_status -ne 0 ]]; then
-  echo "test: a build beside the tests failed (exit $beside_status; log above)"
+  echo "$passed passed, $failed failed, $skipped skipped; the work beside them FAILED"
+  echo "test: a build or the sanitizer tests beside the tests failed (exit $beside_status; log above)"
   exit 1
 fi
 
-SANITIZE_BUILD_DIR=$sanitize_dir "$root/scripts/sanitize.sh" --no-build --fuzz-seconds "$fuzz_seconds" || {
-  echo "$passed passed, $failed failed, $skipped skipped; sanitizer tests or fuzzing FAILED"
-  echo "test: scripts/sanitize.sh failed"
-  exit 1
-}
 # The same count over the sanitizer build's gtest XML.
 read -r san_passed san_failed _ < <(/usr/bin/python3 "$root/test/tools/count_test_results.py" "$sanitize_dir/test_results")
 phase end

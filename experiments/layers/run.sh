@@ -18,7 +18,7 @@ for rev in "$@"; do printf ' %s |' "$(git rev-parse --short "$rev")"; done
 printf '\n|---|'
 for _ in "$@"; do printf -- '---:|'; done
 printf '\n'
-for layer in core sim scenario vehicle rt cycle ros; do
+for layer in core configuration sim scenario vehicle rt cycle ros; do
   printf '| %s |' "$layer"
   for rev in "$@"; do
     if [[ $layer == cycle ]]; then

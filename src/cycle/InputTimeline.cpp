@@ -51,6 +51,15 @@ bool InputTimeline::checkHeader(const std::string& frame_id, std::int64_t stamp_
   return admitted;
 }
 
+void InputTimeline::checkReceipt(std::int64_t now_ns) {
+  if (watch_time_) {
+    noteTime(now_ns);
+  }
+  raw_ns_ = now_ns;
+  now_ns_ = now_ns;
+  offset_ns_ = 0;
+}
+
 void InputTimeline::reject(Rejection kind, const std::string& detail) {
   guard_.reject(kind, detail);
   rejected_.store(guard_.rejected(), std::memory_order_relaxed);

@@ -133,6 +133,28 @@ TEST(InputTimeline, ReceiptPolicyStampsAtReceiptAndKeepsStampsMonotone) {
   EXPECT_EQ(t.accept(), kT0 + 1);
 }
 
+TEST(InputTimeline, AMessageWithoutHeaderIsStampedAtItsReceipt) {
+  InputTimeline t("cmd_vel", optionsOf());
+  EXPECT_EQ(t.age(kT0), kNoInputAge);
+  t.checkReceipt(kT0);
+  EXPECT_EQ(t.accept(), kT0);
+  EXPECT_EQ(t.receipt(), kT0);
+  EXPECT_NEAR(t.age(kT0 + 20 * kMs), 0.020, 1e-12);
+  // Received at the same time (simulated time standing still): accepted, its stamp after the one
+  // before; a content refusal counts.
+  t.checkReceipt(kT0);
+  EXPECT_EQ(t.accept(), kT0 + 1);
+  t.checkReceipt(kT0);
+  t.reject(Rejection::kContent, "non-finite field");
+  EXPECT_EQ(t.rejected(), 1u);
+  EXPECT_EQ(t.guard().accepted(), 2u);
+  // Time going back restarts the timeline: no age until the next message.
+  t.checkReceipt(kT0 - 10 * kSecond);
+  EXPECT_EQ(t.jumps().jumps(), 1u);
+  EXPECT_EQ(t.age(kT0 - 10 * kSecond), kNoInputAge);
+  EXPECT_EQ(t.accept(), kT0 - 10 * kSecond);
+}
+
 TEST(InputTimeline, EstimatedOffsetCorrectsStampsAndNeverGoesBack) {
   InputTimeline t("topic", optionsOf(ClockPolicy::kEstimate));
   const std::int64_t behind = 2 * kSecond;  // the sender's clock is 2 s behind

@@ -7,7 +7,8 @@ positions), /hostile/command and /hostile/adapter_odom (the command adapter) and
 /hostile/cmd_vel, /hostile/cmd_vel_stamped (a unicycle of the plant): stamps 0, now, far ahead,
 far back, the largest ros::Time; frames empty, wrong, 100,000 characters long; values NaN,
 infinite, huge, a zero quaternion. Then every node must answer a ping and do its job with good
-messages: the followers track, the adapter converts a command, the plant drives the unicycle.
+messages: the followers track, the adapter converts a command, the plant drives the unicycle on
+a Twist and on a TwistStamped (and refuses one stamped an hour ahead).
 Parameters: ~seed, ~messages, ~wall_deadline, ~nodes.
 """
 
@@ -183,6 +184,23 @@ class HostileVehicleInputs(unittest.TestCase):
             return len(recent) == 5 and all(math.isfinite(o.pose.pose.position.x) for o in recent) \
                 and recent[-1].twist.twist.linear.x > 0.1
         self.wait_for(driven, "the plant does not drive the unicycle on a good Twist")
+        # A TwistStamped stamped now drives it too, and one stamped an hour ahead after it is
+        # refused by its header (the speed settles at the first one's).
+        def driven_stamped():
+            now = TwistStamped()
+            now.header.stamp = rospy.Time.now()
+            now.twist.linear.x = 0.25
+            self.cmd_vel_stamped.publish(now)
+            ahead = TwistStamped()
+            ahead.header.stamp = now.header.stamp + rospy.Duration(3600.0)
+            ahead.twist.linear.x = 0.05
+            self.cmd_vel_stamped.publish(ahead)
+            with self.lock:
+                recent = self.plant_odometry[-5:]
+            return len(recent) == 5 and all(abs(o.twist.twist.linear.x - 0.25) < 0.02
+                                            for o in recent)
+        self.wait_for(driven_stamped, "the plant does not hold a good TwistStamped and refuse one "
+                                      "stamped ahead")
 
 
 if __name__ == "__main__":

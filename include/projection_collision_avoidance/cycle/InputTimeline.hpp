@@ -73,6 +73,13 @@ class InputTimeline {
   /// the caller checks the content and calls accept() or reject().
   bool checkHeader(const std::string& frame_id, std::int64_t stamp_ns, std::int64_t now_ns);
 
+  /// Takes a message without a header (geometry_msgs/Twist, say) received at @p now_ns: notes
+  /// the time (with watch_time); its stamp is its receipt, so there is no header to judge, and
+  /// messages received at one time (a clock that stands still) are not out of order. The caller
+  /// checks the content and calls accept() (whose stamp still lies after the one before) or
+  /// reject().
+  void checkReceipt(std::int64_t now_ns);
+
   /// Counts a refusal of @p kind of the message being judged; @p detail says what was wrong.
   void reject(Rejection kind, const std::string& detail);
 

@@ -1,7 +1,6 @@
 #include "follower/FollowerInputs.hpp"
 
 #include <algorithm>
-#include <cmath>
 #include <utility>
 
 #include "projection_collision_avoidance/ros/MessageConversions.hpp"
@@ -68,8 +67,7 @@ FollowerInputStats FollowerInputs::stats(std::int64_t now_ns) const {
   stats.clock_offset = clock_offset_.load(std::memory_order_relaxed);
   if (const MeasurementAdapter* adapter = adapter_.load(std::memory_order_acquire)) {
     stats.rejected_input = adapter->rejected();
-    const double skew = adapter->skew();
-    stats.input_skew = std::isfinite(skew) ? skew : -1.0;
+    stats.input_skew = adapter->skew();
   }
   const std::lock_guard<std::mutex> lock(reasons_mutex_);
   stats.measurement_rejection = measurement_rejection_;

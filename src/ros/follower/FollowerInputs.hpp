@@ -37,7 +37,9 @@ struct FollowerInputStats {
   double leader_age = kNoInputAge;   ///< s, of the last accepted leader broadcast; +inf: none
   std::uint64_t rejected_input = 0;  ///< messages the input adapter refused (~input not
                                      ///< relative_measurement)
-  double input_skew = -1.0;          ///< s, the adapter's latest skew; -1: none
+  /// s, the skew of the adapter's latest accepted input (its two stamps apart); NaN: none, as
+  /// the other skews
+  double input_skew = std::numeric_limits<double>::quiet_NaN();
   /// s, receipt − stamp of the latest accepted measurement / leader broadcast; NaN: none
   double measurement_skew = std::numeric_limits<double>::quiet_NaN();
   double leader_skew = std::numeric_limits<double>::quiet_NaN();

@@ -36,8 +36,11 @@ PlantVehicle::PlantVehicle(const VehicleOptions& options, Setup setup,
       twist_in_body_(options.twist_in_body),
       setup_(std::move(setup)),
       odom_frame_(options.odom_frame),
-      twist_guard_(setup_.agent_name + "/cmd_vel", InputGuardLimits{}),
-      stamped_guard_(setup_.agent_name + "/cmd_vel_stamped", InputGuardLimits{}) {
+      // Jumps back of the plant's time come from its clock (restartTimeline()).
+      twist_timeline_(setup_.agent_name + "/cmd_vel", {InputGuardLimits{}, {}, false}),
+      stamped_timeline_(
+          setup_.agent_name + "/cmd_vel_stamped",
+          {{"", setup_.command_timeout, setup_.command_timeout}, setup_.clock_skew, false}) {
   const int k = setup_.axes;
   const Eigen::Vector3d p0 = toVector3(initial_state.head(k));
   const Eigen::Vector3d v0 = toVector3(initial_state.tail(k));
@@ -75,14 +78,11 @@ void PlantVehicle::connect(ros::NodeHandle& nh, std::mutex* mutex, std::function
   odom_publisher_ = nh.advertise<nav_msgs::Odometry>(agent + "/odom", 10);
   applied_publisher_ = nh.advertise<geometry_msgs::TwistStamped>(agent + "/applied_command", 10);
   twist_subscriber_ = nh.subscribe<geometry_msgs::Twist>(
-      agent + "/cmd_vel", 10,
-      [this](const geometry_msgs::Twist::ConstPtr& msg) { onTwist(&twist_guard_, *msg); },
+      agent + "/cmd_vel", 10, [this](const geometry_msgs::Twist::ConstPtr& msg) { onTwist(*msg); },
       ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
   stamped_subscriber_ = nh.subscribe<geometry_msgs::TwistStamped>(
       agent + "/cmd_vel_stamped", 10,
-      [this](const geometry_msgs::TwistStamped::ConstPtr& msg) {
-        onTwist(&stamped_guard_, msg->twist);
-      },
+      [this](const geometry_msgs::TwistStamped::ConstPtr& msg) { onTwistStamped(*msg); },
       ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
 }
 
@@ -101,24 +101,40 @@ bool PlantVehicle::commandOf(const geometry_msgs::Twist& twist, Eigen::Vector3d*
   return true;
 }
 
-void PlantVehicle::onTwist(InputGuard* guard, const geometry_msgs::Twist& twist) {
+void PlantVehicle::onTwist(const geometry_msgs::Twist& twist) {
   const std::lock_guard<std::mutex> lock(*mutex_);
-  admitGuarded(*guard, setup_.node_name, [&] {
-    std::string why;
-    Eigen::Vector3d command;
-    if (!commandOf(twist, &command, &why)) {
-      guard->reject(Rejection::kContent, why);
-      return;
-    }
+  admitGuarded(twist_timeline_, setup_.node_name, [&] {
     const ros::Time now = now_();
-    if (!have_command_ && !twist_guard_.everAccepted() && !stamped_guard_.everAccepted()) {
-      ROS_INFO_STREAM(setup_.node_name << ": first " << setup_.agent_name << " velocity command");
-    }
-    command_ = command;
-    have_command_ = true;
-    received_ = now;
-    guard->accept(nanosecondsOf(now), nanosecondsOf(now));
+    twist_timeline_.checkReceipt(nanosecondsOf(now));
+    hold(&twist_timeline_, twist, now);
   });
+}
+
+void PlantVehicle::onTwistStamped(const geometry_msgs::TwistStamped& message) {
+  const std::lock_guard<std::mutex> lock(*mutex_);
+  admitGuarded(stamped_timeline_, setup_.node_name, [&] {
+    const ros::Time now = now_();
+    if (checkHeader(stamped_timeline_, message.header, now)) {
+      hold(&stamped_timeline_, message.twist, now);
+    }
+  });
+}
+
+void PlantVehicle::hold(InputTimeline* timeline, const geometry_msgs::Twist& twist,
+                        const ros::Time& now) {
+  std::string why;
+  Eigen::Vector3d command;
+  if (!commandOf(twist, &command, &why)) {
+    timeline->reject(Rejection::kContent, why);
+    return;
+  }
+  if (!twist_timeline_.guard().everAccepted() && !stamped_timeline_.guard().everAccepted()) {
+    ROS_INFO_STREAM(setup_.node_name << ": first " << setup_.agent_name << " velocity command");
+  }
+  command_ = command;
+  have_command_ = true;
+  received_ = now;
+  timeline->accept();
 }
 
 Eigen::VectorXd PlantVehicle::state() const {
@@ -208,6 +224,8 @@ void PlantVehicle::advance(double h, const ros::Time& stamp) {
 void PlantVehicle::restartTimeline() {
   have_command_ = false;
   timed_out_ = false;
+  twist_timeline_.restart();
+  stamped_timeline_.restart();
 }
 
 }  // namespace projection_collision_avoidance

@@ -13,7 +13,8 @@
 #include <geometry_msgs/TwistStamped.h>
 #include <ros/ros.h>
 
-#include "projection_collision_avoidance/cycle/InputGuard.hpp"
+#include "projection_collision_avoidance/cycle/InputTimeline.hpp"
+#include "projection_collision_avoidance/cycle/StampCorrection.hpp"
 #include "projection_collision_avoidance/sim/VehicleModels.hpp"
 
 #include "plant/PlantOptions.hpp"
@@ -25,12 +26,15 @@ namespace projection_collision_avoidance {
 /// publishes it.
 ///
 /// Subscribes `<agent>/cmd_vel` (geometry_msgs/Twist) and `<agent>/cmd_vel_stamped`
-/// (geometry_msgs/TwistStamped, its header unused). A message with any non-finite field is
-/// refused, counted and logged per topic (InputGuard); the latest accepted command is held and,
-/// once older than the command timeout by its receipt (plant) time, replaced by zero: the
-/// vehicle stops. `velocity`: the linear part, in the body frame (turned into the world by the
-/// fixed heading) or the world frame (twist_frame), on the model's axes (others ignored), angular
-/// ignored; `unicycle`: linear.x and angular.z, the rest ignored.
+/// (geometry_msgs/TwistStamped), each on an InputTimeline of its own: a Twist, without a header,
+/// is stamped at its receipt; a TwistStamped's header is judged as the plant's commands are (a
+/// zero stamp, one ahead of or behind the plant's time by more than the command timeout after
+/// ~clock_skew's offset, one not after the last; any frame_id). A message with any non-finite
+/// field is refused; refusals are counted and logged per topic. The latest accepted command of
+/// either topic is held and, once older than the command timeout by its receipt (plant) time,
+/// replaced by zero: the vehicle stops. `velocity`: the linear part, in the body frame (turned into
+/// the world by the fixed heading) or the world frame (twist_frame), on the model's axes (others
+/// ignored), angular ignored; `unicycle`: linear.x and angular.z, the rest ignored.
 ///
 /// Publishes `<agent>/odom` (REP 105: pose in the world frame with the yaw, twist in the body
 /// frame, the agent's frame as child; with an odom_frame, the pose in that frame, which starts at
@@ -49,6 +53,8 @@ class PlantVehicle {
     std::string world_frame;
     int axes = 1;                  ///< k of the scenario's model
     double command_timeout = 0.5;  ///< s of plant time since receipt
+    /// How cmd_vel_stamped's stamps are put on the plant's clock (~clock_skew).
+    StampCorrectionOptions clock_skew;
   };
 
   /// @param initial_state [p; v] (2k entries) of the scenario; a unicycle takes the velocity's
@@ -71,7 +77,8 @@ class PlantVehicle {
                      std::vector<geometry_msgs::TransformStamped>* transforms) const;
   /// Integrates @p h (s) with the command held at plant time @p stamp, and publishes it.
   void advance(double h, const ros::Time& stamp);
-  /// Plant time went back: the held command is forgotten (a stop until the next one).
+  /// Plant time went back: the held command and both inputs' timelines are forgotten (a stop
+  /// until the next command).
   void restartTimeline();
   /// Whether a follower drives it: its odometry has a subscriber and cmd_vel or cmd_vel_stamped
   /// a publisher.
@@ -99,7 +106,11 @@ class PlantVehicle {
   /// The command of a Twist's content; false, with the reason, when it is refused.
   bool commandOf(const geometry_msgs::Twist& twist, Eigen::Vector3d* command,
                  std::string* why) const;
-  void onTwist(InputGuard* guard, const geometry_msgs::Twist& twist);
+  void onTwist(const geometry_msgs::Twist& twist);
+  void onTwistStamped(const geometry_msgs::TwistStamped& message);
+  /// Holds @p twist received at @p now, admitted so far by @p timeline: its content judged, then
+  /// accepted or refused there.
+  void hold(InputTimeline* timeline, const geometry_msgs::Twist& twist, const ros::Time& now);
 
   VehicleKind kind_;
   bool twist_in_body_;
@@ -113,8 +124,8 @@ class PlantVehicle {
 
   std::mutex* mutex_ = nullptr;
   std::function<ros::Time()> now_;
-  InputGuard twist_guard_;
-  InputGuard stamped_guard_;
+  InputTimeline twist_timeline_;                       ///< cmd_vel: stamped at receipt
+  InputTimeline stamped_timeline_;                     ///< cmd_vel_stamped: its header judged
   Eigen::Vector3d command_ = Eigen::Vector3d::Zero();  ///< held: world velocity or (v, ω, 0)
   bool have_command_ = false;
   ros::Time received_;      ///< plant time of the held command's receipt

@@ -208,7 +208,7 @@ void PlantWorld::attachVehicle(Agent* agent) {
   agent->vehicle = std::make_unique<PlantVehicle>(
       found->second,
       PlantVehicle::Setup{name_, agent->name, agent->frame, options_.world_frame, axes_,
-                          options_.command_timeout},
+                          options_.command_timeout, options_.clock_skew},
       agent->integrator.state());
   ROS_INFO_STREAM(name_ << ": " << agent->name << " is a " << toString(found->second.kind)
                         << " vehicle: commands on " << agent->name << "/cmd_vel");
