@@ -6,6 +6,8 @@
 #include <sstream>
 #include <utility>
 
+#include "projection_collision_avoidance/cycle/FrameNames.hpp"
+
 namespace projection_collision_avoidance {
 namespace {
 
@@ -56,7 +58,7 @@ InputGuard::InputGuard(std::string topic, InputGuardLimits limits, Clock::time_p
 
 bool InputGuard::checkHeader(const std::string& frame_id, std::int64_t stamp_ns,
                              std::int64_t now_ns) {
-  if (!limits_.required_frame.empty() && frame_id != limits_.required_frame) {
+  if (!limits_.required_frame.empty() && !sameFrame(frame_id, limits_.required_frame)) {
     reject(Rejection::kFrame, "frame_id '" + boundedText(frame_id, kMaxQuotedLength) +
                                   "', expected '" + limits_.required_frame + "'");
     return false;

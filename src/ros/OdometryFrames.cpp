@@ -4,6 +4,7 @@
 #include <tf2/exceptions.h>
 #include <tf2_eigen/tf2_eigen.h>
 
+#include "projection_collision_avoidance/cycle/FrameNames.hpp"
 #include "projection_collision_avoidance/cycle/InputGuard.hpp"
 #include "projection_collision_avoidance/ros/MessageConversions.hpp"
 
@@ -13,13 +14,13 @@ bool odometryInFrame(const nav_msgs::Odometry& msg, const std::string& world_fra
                      bool twist_in_body_frame, const tf2_ros::Buffer& tf_buffer, double tf_timeout,
                      OdometrySample* sample, std::string* why) {
   *sample = toOdometrySample(msg);
-  if (world_frame.empty() || msg.header.frame_id == world_frame) {
+  if (world_frame.empty() || sameFrame(msg.header.frame_id, world_frame)) {
     return true;
   }
   geometry_msgs::TransformStamped transform;
   try {
-    transform = tf_buffer.lookupTransform(world_frame, msg.header.frame_id, msg.header.stamp,
-                                          ros::Duration(tf_timeout));
+    transform = tf_buffer.lookupTransform(tfFrame(world_frame), tfFrame(msg.header.frame_id),
+                                          msg.header.stamp, ros::Duration(tf_timeout));
   } catch (const tf2::TransformException& error) {
     *why = "no transform from \"" + boundedText(msg.header.frame_id, InputGuard::kMaxQuotedLength) +
            "\" to \"" + world_frame + "\": " + error.what();

@@ -9,6 +9,7 @@
 
 #include "projection_collision_avoidance/configuration/ConfigurationLoader.hpp"
 #include "projection_collision_avoidance/core/ParameterError.hpp"
+#include "projection_collision_avoidance/cycle/FrameNames.hpp"
 
 namespace projection_collision_avoidance {
 namespace {
@@ -170,6 +171,10 @@ FollowerConfiguration loadFollowerConfiguration(const ros::NodeHandle& private_n
         configuration = followerConfigurationFromYaml(tree, {}, options);
       });
   return configuration;
+}
+
+std::string NodeOptionReader::frame(const std::string& key, const std::string& fallback) {
+  return tfFrame(text(key, fallback));
 }
 
 bool NodeOptionReader::lookup(const std::string& key, XmlRpc::XmlRpcValue* value) const {

@@ -46,6 +46,20 @@ TEST(InputGuard, RefusesZeroFutureStaleOutOfOrderAndRepeatedStamps) {
   EXPECT_EQ(guard.rejected(), 5U);
 }
 
+TEST(InputGuard, AFrameMatchesUpToALeadingSlash) {
+  // "/robot_0/odom" (a ROS 1 driver's spelling) and "robot_0/odom" (tf2's) name one frame.
+  const std::int64_t now = 100 * kSecond;
+  InputGuard guard = makeGuard(0.1, 0.5, "robot_0/odom");
+  EXPECT_TRUE(guard.checkHeader("/robot_0/odom", now, now));
+  InputGuard slashed = makeGuard(0.1, 0.5, "/robot_0/odom");
+  EXPECT_TRUE(slashed.checkHeader("robot_0/odom", now, now));
+  EXPECT_TRUE(slashed.checkHeader("/robot_0/odom", now, now));
+  EXPECT_FALSE(slashed.checkHeader("robot_1/odom", now, now));
+  EXPECT_FALSE(slashed.checkHeader("//robot_0/odom", now, now));  // tf2 strips one slash only
+  EXPECT_FALSE(slashed.checkHeader("", now, now));
+  EXPECT_EQ(slashed.rejected(), 3U);
+}
+
 TEST(InputGuard, JudgesStampsOverTheWholeRangeOfRosTime) {
   for (const std::int64_t now : {std::int64_t{1}, 1700000000 * kSecond, kLatest}) {
     for (const std::int64_t stamp :

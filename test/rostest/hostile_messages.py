@@ -106,16 +106,21 @@ class Generator:
         vectors[name][0] = self.rng.choice((math.nan, math.inf, -math.inf))  # good sizes are > 0
         return self.good_stamp(now), self.frame, vectors, False
 
+    def slashed_frame(self, now):
+        """The frame with a leading slash, as ROS 1 drivers write it: the same frame."""
+        return self.good_stamp(now), "/" + self.frame, self.good_values(self.rng), True
+
     def wrong_frame(self, now):
+        # "/" + frame names the same frame for tf2 (accepted); "//" + frame does not.
         frame = self.rng.choice(("", "map", self.frame + " ", "x" * (1 << 20),
-                                 "\u00e9\u4e2d\u0000", "/" + self.frame))
+                                 "\u00e9\u4e2d\u0000", "//" + self.frame))
         return self.good_stamp(now), frame, self.good_values(self.rng), False
 
 
 KINDS = [Generator.good, Generator.good, Generator.good, Generator.extreme_finite,
          Generator.zero_stamp, Generator.future_stamp, Generator.stale_stamp,
          Generator.out_of_order, Generator.repeated_stamp, Generator.wrong_size,
-         Generator.non_finite, Generator.wrong_frame]
+         Generator.non_finite, Generator.wrong_frame, Generator.slashed_frame]
 
 
 def any_values(rng, sizes):

@@ -25,7 +25,8 @@ const char* toString(Rejection kind);
 
 /// What an input guard admits: the header checks of one input topic.
 struct InputGuardLimits {
-  std::string required_frame;   ///< frame_id a message must carry; "" accepts any
+  /// frame_id a message must carry, up to a leading slash (sameFrame()); "" accepts any
+  std::string required_frame;
   double max_future_stamp = 0;  ///< s a stamp may lie ahead of the receiver's clock (offsets)
   double max_age = 0;           ///< s a message may be old when it arrives; <= 0: no limit
 };

@@ -76,6 +76,9 @@ class NodeOptionReader {
   int integer(const std::string& key, int fallback, int min, int max);
   bool boolean(const std::string& key, bool fallback);
   std::string text(const std::string& key, const std::string& fallback);
+  /// A frame name: text() without a leading slash (tfFrameName(): "/robot_0/odom" is tf2's
+  /// "robot_0/odom").
+  std::string frame(const std::string& key, const std::string& fallback);
   /// A list of at most @p max_entries strings; empty when absent.
   /// @throws ParameterError ("~<key>", or "~<key>[i]" for an entry) when it is not a list, is
   ///         longer, or an entry is not a string

@@ -7,6 +7,7 @@
 #include <geometry_msgs/TwistStamped.h>
 #include <geometry_msgs/Vector3Stamped.h>
 
+#include "projection_collision_avoidance/cycle/FrameNames.hpp"
 #include "projection_collision_avoidance/ros/MessageConversions.hpp"
 #include "projection_collision_avoidance/ros/OdometryFrames.hpp"
 #include "projection_collision_avoidance/ros/RosParameters.hpp"
@@ -101,9 +102,10 @@ void CommandAdapter::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
     }
     odometry_timeline_.accept();
     if (options_->base_frame.empty()) {
-      base_frame_ = msg->child_frame_id;
+      base_frame_ = tfFrame(msg->child_frame_id);
     }
-    world_frame_ = options_->world_frame.empty() ? msg->header.frame_id : options_->world_frame;
+    world_frame_ =
+        options_->world_frame.empty() ? tfFrame(msg->header.frame_id) : options_->world_frame;
   });
 }
 

@@ -89,8 +89,8 @@ CommandAdapterOptions readCommandAdapterOptions(NodeOptionReader& reader) {
   c.unicycle_limits.max_speed = limitOrNone(reader, "unicycle/max_speed", 1e4);
   c.unicycle_limits.max_yaw_rate = limitOrNone(reader, "unicycle/max_yaw_rate", 1e4);
   c.stop_deceleration = reader.number("stop_deceleration", c.stop_deceleration, 1e-3, 1e3);
-  options.base_frame = reader.text("base_frame", "");
-  options.world_frame = reader.text("world_frame", "");
+  options.base_frame = reader.frame("base_frame", "");
+  options.world_frame = reader.frame("world_frame", "");
   return options;
 }
 

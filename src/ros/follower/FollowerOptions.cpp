@@ -67,7 +67,7 @@ OdometryInputOptions readOdometryOptions(NodeOptionReader& reader) {
 }
 
 std::string requiredFrame(NodeOptionReader& reader, const std::string& key) {
-  const std::string frame = reader.text(key, "");
+  const std::string frame = reader.frame(key, "");
   if (frame.empty()) {
     throw ParameterError("~" + key, "must name a tf frame with ~input tf");
   }
@@ -118,10 +118,10 @@ FollowerNodeOptions readFollowerOptions(NodeOptionReader& reader, const Controll
   options.max_future_stamp =
       reader.number("max_future_stamp", options.max_future_stamp, 0.0, 3600.0);
   options.use_leader_broadcast = reader.boolean("use_leader_broadcast", false);
-  options.measurement_frame = reader.text("measurement_frame", "");
-  options.leader_broadcast_frame = reader.text("leader_broadcast_frame", "");
-  options.odom_frame = reader.text("odom_frame", "");
-  options.follower_frame = reader.text("follower_frame", member.name);
+  options.measurement_frame = reader.frame("measurement_frame", "");
+  options.leader_broadcast_frame = reader.frame("leader_broadcast_frame", "");
+  options.odom_frame = reader.frame("odom_frame", "");
+  options.follower_frame = reader.frame("follower_frame", member.name);
   if (options.follower_frame.empty()) {
     throw ParameterError("~follower_frame", "must not be empty");
   }

@@ -4,6 +4,7 @@
 #include <limits>
 #include <utility>
 
+#include "projection_collision_avoidance/cycle/FrameNames.hpp"
 #include "projection_collision_avoidance/ros/OdometryFrames.hpp"
 
 namespace projection_collision_avoidance {
@@ -67,7 +68,7 @@ void OdometryInput::onOdometry(Side* side, const nav_msgs::Odometry::ConstPtr& m
       return;
     }
     if (side == &self_ && options_.measurement_frame.empty()) {
-      world_frame_ = msg->header.frame_id;  // the own odometry's frame is the world
+      world_frame_ = tfFrame(msg->header.frame_id);  // the own odometry's frame is the world
     }
     std::string why;
     OdometrySample sample;
@@ -78,7 +79,7 @@ void OdometryInput::onOdometry(Side* side, const nav_msgs::Odometry::ConstPtr& m
     }
     timeline.accept();
     side->sample = sample;
-    side->frame = world_frame_.empty() ? msg->header.frame_id : world_frame_;
+    side->frame = world_frame_.empty() ? tfFrame(msg->header.frame_id) : world_frame_;
     side->msg = msg;
     side->stamp = msg->header.stamp;
     side->have = true;

@@ -9,6 +9,7 @@
 #include <tf2_eigen/tf2_eigen.h>
 
 #include "projection_collision_avoidance/core/ParameterError.hpp"
+#include "projection_collision_avoidance/cycle/FrameNames.hpp"
 #include "projection_collision_avoidance/ros/MessageConversions.hpp"
 
 namespace projection_collision_avoidance {
@@ -96,11 +97,11 @@ void PositionInput::onPosition(InputTimeline* timeline, const std_msgs::Header& 
     }
     Eigen::Vector3d world = p;
     const std::string& world_frame = options_.measurement_frame;
-    if (!world_frame.empty() && header.frame_id != world_frame) {
+    if (!world_frame.empty() && !sameFrame(header.frame_id, world_frame)) {
       // p is a vector between two points: only the rotation world ← frame acts on it.
       geometry_msgs::TransformStamped transform;
       try {
-        transform = tf_buffer_.lookupTransform(world_frame, header.frame_id, header.stamp,
+        transform = tf_buffer_.lookupTransform(world_frame, tfFrame(header.frame_id), header.stamp,
                                                ros::Duration(options_.position.tf_timeout));
       } catch (const tf2::TransformException& error) {
         timeline->reject(Rejection::kContent,
@@ -112,7 +113,8 @@ void PositionInput::onPosition(InputTimeline* timeline, const std_msgs::Header& 
       world = tf2::transformToEigen(transform).rotation() * p;
     }
     std::string why;
-    if (!filter(header.stamp, world_frame.empty() ? header.frame_id : world_frame, world, &why)) {
+    if (!filter(header.stamp, world_frame.empty() ? tfFrame(header.frame_id) : world_frame, world,
+                &why)) {
       timeline->reject(Rejection::kContent, why);
       return;
     }

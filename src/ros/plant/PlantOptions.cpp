@@ -15,7 +15,7 @@ namespace {
 
 std::string frameParameter(NodeOptionReader& reader, const std::string& key,
                            const std::string& fallback) {
-  const std::string frame = reader.text(key, fallback);
+  const std::string frame = reader.frame(key, fallback);
   if (frame.empty()) {
     throw ParameterError("~" + key, "must not be empty");
   }
@@ -87,7 +87,7 @@ VehicleOptions readVehicle(NodeOptionReader& reader, const std::string& agent, i
   v.velocity_lag = reader.number(prefix + "/velocity_lag", 0.0, 0.0, 1000.0);
   v.max_speed = limitParameter(reader, prefix + "/max_speed");
   v.heading = reader.number(prefix + "/heading", 0.0, -kTwoPi, kTwoPi);
-  v.odom_frame = reader.text(prefix + "/odom_frame", "");
+  v.odom_frame = reader.frame(prefix + "/odom_frame", "");
   if (v.kind == VehicleKind::kUnicycle) {
     v.max_yaw_rate = limitParameter(reader, prefix + "/max_yaw_rate");
   } else {

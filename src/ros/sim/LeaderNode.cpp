@@ -5,6 +5,7 @@
 
 #include "projection_collision_avoidance/LeaderBroadcast.h"
 #include "projection_collision_avoidance/core/ParameterError.hpp"
+#include "projection_collision_avoidance/cycle/FrameNames.hpp"
 #include "projection_collision_avoidance/ros/MessageConversions.hpp"
 #include "projection_collision_avoidance/ros/RosParameters.hpp"
 #include "projection_collision_avoidance/ros/ScenarioParameters.hpp"
@@ -15,7 +16,7 @@ namespace {
 LeaderNodeOptions readOptions(NodeOptionReader& reader, const Scenario& scenario) {
   LeaderNodeOptions o;
   o.rate = reader.number("rate", scenario.controller.control_rate, 1.0, 10000.0);
-  o.leader_frame = reader.text("leader_frame", o.leader_frame);
+  o.leader_frame = reader.frame("leader_frame", o.leader_frame);
   if (o.leader_frame.empty()) {
     throw ParameterError("~leader_frame", "must not be empty");
   }
@@ -53,7 +54,7 @@ void LeaderNode::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
     if (!checkHeader(odometry_timeline_, msg->header, now)) {
       return;
     }
-    if (msg->child_frame_id != options_.leader_frame) {
+    if (!sameFrame(msg->child_frame_id, options_.leader_frame)) {
       odometry_timeline_.reject(Rejection::kContent,
                                 "child_frame_id '" +
                                     boundedText(msg->child_frame_id, InputGuard::kMaxQuotedLength) +

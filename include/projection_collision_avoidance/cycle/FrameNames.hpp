@@ -1,0 +1,28 @@
+#pragma once
+
+/// @file
+/// Frame names as tf2 knows them. Many ROS 1 drivers and simulator bridges write a leading slash
+/// ("/robot_0/odom", the tf of ROS before tf2); tf2 drops one leading slash from every transform
+/// it receives and refuses such a name in a lookup. Every frame name the package compares or
+/// looks up (a message's header.frame_id and child_frame_id, a frame parameter) goes through
+/// tfFrameName() first, so that "/robot_0/odom" and "robot_0/odom" name one frame. ROS-free.
+
+#include <string>
+#include <string_view>
+
+namespace projection_collision_avoidance {
+
+/// @p name without one leading '/', as tf2 strips it ("/a/b" -> "a/b", "//a" -> "/a", "" -> "").
+inline std::string_view tfFrameName(std::string_view name) {
+  return !name.empty() && name.front() == '/' ? name.substr(1) : name;
+}
+
+/// tfFrameName() as a string, for tf2's lookups and the frames the package publishes.
+inline std::string tfFrame(std::string_view name) { return std::string(tfFrameName(name)); }
+
+/// Whether @p a and @p b name the same frame for tf2 (equal up to a leading slash each).
+inline bool sameFrame(std::string_view a, std::string_view b) {
+  return tfFrameName(a) == tfFrameName(b);
+}
+
+}  // namespace projection_collision_avoidance
