@@ -47,7 +47,7 @@ FollowerCycle::~FollowerCycle() = default;
 bool FollowerCycle::tickLatched(std::int64_t now_ns, std::int64_t steady_ns, double delay,
                                 std::uint32_t skipped, FollowerCycleOutput* out) {
   out->stepped = false;
-  time_.wentBack(now_ns);  // counted and reported (time_jump) by fillCounters()
+  noteTime(now_ns);
   inputs_.checkTimeline(now_ns);
   if (stall_wait_.holds(steady_ns, delay, inputs_.measurement().sequence)) {
     addSaturated(&missed_periods_, skipped + 1);
@@ -70,6 +70,7 @@ bool FollowerCycle::tickLatched(std::int64_t now_ns, std::int64_t steady_ns, dou
 
 bool FollowerCycle::stepOnLatchedMeasurement(std::int64_t now_ns, std::uint32_t skipped,
                                              FollowerCycleOutput* out) {
+  noteTime(now_ns);
   inputs_.checkTimeline(now_ns);
   if (!inputs_.haveMeasurement()) {
     out->stepped = false;
@@ -126,13 +127,22 @@ bool FollowerCycle::step(std::int64_t now_ns, std::int64_t stamp_ns, double dela
   }
   const DynamicFollowerStatus* status = &controller.step(inputs);
   out->stepped = true;
-  out->stamp_ns = stamp_ns;
+  out->stamp_ns = have_stamp_ && stamp_ns <= last_stamp_ns_ ? last_stamp_ns_ + 1 : stamp_ns;
+  last_stamp_ns_ = out->stamp_ns;
+  have_stamp_ = true;
   out->steps = steps_;
   out->measurement_age = ages.measurement_age;
   out->leader_age = ages.leader_age;
   out->status = *status;
   fillCounters(now_ns, out);
   return true;
+}
+
+void FollowerCycle::noteTime(std::int64_t now_ns) {
+  // Counted and reported (time_jump) by fillCounters(); a new timeline's stamps start afresh.
+  if (time_.wentBack(now_ns)) {
+    have_stamp_ = false;
+  }
 }
 
 void FollowerCycle::fillCounters(std::int64_t now_ns, FollowerCycleOutput* out) const {

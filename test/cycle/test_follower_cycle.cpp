@@ -244,6 +244,24 @@ TEST(FollowerCycle, AJumpBackOfTimeInvalidatesTheOldTimelinesInputs) {
   EXPECT_GE(out.measurement_age, 0.0);
 }
 
+TEST(FollowerCycle, NoTwoStepsCarryOneStampWhileTheClockStandsStill) {
+  // A bursty simulated clock: ticks at one time. Each step's stamp lies 1 ns after the one
+  // before; once the clock moves on, the stamps are its times again.
+  std::unique_ptr<FollowerCycle> cycle = makeCycle();
+  FollowerCycleOutput out;
+  cycle->measurement().write(measurementAt(kStart, 1, 5.0));
+  for (std::int64_t i = 0; i < 3; ++i) {
+    ASSERT_TRUE(cycle->tick(kStart + kMs, 0.0, 0, &out));
+    EXPECT_EQ(out.stamp_ns, kStart + kMs + i);
+  }
+  ASSERT_TRUE(cycle->tick(kStart + 2 * kMs, 0.0, 0, &out));
+  EXPECT_EQ(out.stamp_ns, kStart + 2 * kMs);
+  // Time going back starts a new timeline: its own time again, not 1 ns after the old one.
+  cycle->measurement().write(measurementAt(kStart - 1000 * kMs, 2, 5.0));
+  ASSERT_TRUE(cycle->tick(kStart - 999 * kMs, 0.0, 0, &out));
+  EXPECT_EQ(out.stamp_ns, kStart - 999 * kMs);
+}
+
 TEST(FollowerCycle, AMeasurementArrivingAsATickBeginsIsNotTakenForAnOldTimeline) {
   // The input thread writes a measurement received 1 us after the control thread read ROS time.
   // Latched with that earlier time, it would look received in the future (of an old timeline)

@@ -36,11 +36,14 @@ struct FollowerCycleSettings {
 /// What a tick or step gives the outputs: the step's results when one ran, and the counters.
 /// Fixed size: filling it allocates nothing.
 struct FollowerCycleOutput {
-  bool stepped = false;       ///< a control step ran (else: waiting, stalled, or a tick of the
-                              ///< measurement trigger while the measurement is fresh)
-  std::int64_t now_ns = 0;    ///< ROS time of the tick or measurement that gave this output
-  std::int64_t stamp_ns = 0;  ///< the step's stamp: tick time, or the measurement's stamp
-  std::uint64_t steps = 0;    ///< control steps run since start, this one included
+  bool stepped = false;     ///< a control step ran (else: waiting, stalled, or a tick of the
+                            ///< measurement trigger while the measurement is fresh)
+  std::int64_t now_ns = 0;  ///< ROS time of the tick or measurement that gave this output
+  /// the step's stamp: tick time, or the measurement's stamp; 1 ns after the step before when
+  /// that is not later (a clock standing still, a measurement stamped as the one before), so that
+  /// no two commands carry one stamp
+  std::int64_t stamp_ns = 0;
+  std::uint64_t steps = 0;  ///< control steps run since start, this one included
   FollowerMode mode = FollowerMode::kWaiting;
   bool leader_fresh = false;
   double measurement_age = 0.0;  ///< s at the stamp; +inf when none on this timeline
@@ -188,6 +191,8 @@ class FollowerCycle {
                                 FollowerCycleOutput* out);
   /// The counters and the design in force into @p out (whether or not a step ran).
   void fillCounters(std::int64_t now_ns, FollowerCycleOutput* out) const;
+  /// Notes ROS time @p now_ns: a jump back is counted, and the stamps start afresh.
+  void noteTime(std::int64_t now_ns);
 
   ControllerHandover handover_;  ///< the controller in force, and a new design's
   GenericDimensions::StateVector separation_;
@@ -195,11 +200,13 @@ class FollowerCycle {
   double period_ = 0.0;
   std::mutex trigger_mutex_;  ///< measurement trigger only: callback steps vs braking ticks
   LatchedInputs inputs_;
-  TimeJumpWatch time_;    ///< jumps back of ROS time at the ticks
+  TimeJumpWatch time_;    ///< jumps back of ROS time at the ticks and measurement steps
   StallWait stall_wait_;  ///< the wait for input after a stall
 
   FollowerMode mode_ = FollowerMode::kWaiting;
   std::uint64_t steps_ = 0;
+  std::int64_t last_stamp_ns_ = 0;  ///< the latest step's stamp on this timeline
+  bool have_stamp_ = false;         ///< a step ran on this timeline
   std::uint32_t missed_periods_ = 0;
   std::uint32_t late_periods_ = 0;
   double tick_delay_ = 0.0;
