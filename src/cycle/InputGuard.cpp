@@ -58,6 +58,7 @@ InputGuard::InputGuard(std::string topic, InputGuardLimits limits, Clock::time_p
 
 bool InputGuard::checkHeader(const std::string& frame_id, std::int64_t stamp_ns,
                              std::int64_t now_ns) {
+  last_superseded_ = false;
   if (!limits_.required_frame.empty() && !sameFrame(frame_id, limits_.required_frame)) {
     reject(Rejection::kFrame, "frame_id '" + boundedText(frame_id, kMaxQuotedLength) +
                                   "', expected '" + limits_.required_frame + "'");
@@ -80,6 +81,10 @@ bool InputGuard::checkHeader(const std::string& frame_id, std::int64_t stamp_ns,
     why << "stamped " << kNanosecond * static_cast<double>(-ahead_ns) << " s ago, older than "
         << limits_.max_age << " s";
     reject(Rejection::kStale, why.str());
+    return false;
+  }
+  if (have_accepted_ && stamp_ns <= last_stamp_ns_ && limits_.supersede_older) {
+    supersede();
     return false;
   }
   if (have_accepted_ && stamp_ns < last_stamp_ns_) {
@@ -113,6 +118,25 @@ void InputGuard::reject(Rejection kind, const std::string& detail) {
     last_log_ = now;
     unlogged_ = 0;
   }
+}
+
+void InputGuard::supersede() {
+  ++superseded_;
+  ++unlogged_superseded_;
+  last_superseded_ = true;
+  const Clock::time_point now = clock_();
+  if (have_logged_superseded_ && now - last_superseded_log_ < kSummaryPeriod) {
+    return;
+  }
+  std::ostringstream line;
+  line << topic_ << ": " << unlogged_superseded_
+       << (unlogged_superseded_ == 1 ? " message" : " messages")
+       << " stamped at or before the latest accepted one dropped as superseded (not refused; "
+       << superseded_ << " in all)";
+  log_line_ = line.str();
+  have_logged_superseded_ = true;
+  last_superseded_log_ = now;
+  unlogged_superseded_ = 0;
 }
 
 void InputGuard::accept(std::int64_t stamp_ns, std::int64_t now_ns) {

@@ -24,6 +24,7 @@ InputTimeline& InputTimeline::operator=(InputTimeline&& other) noexcept {
   stamp_ns_.store(other.stamp_ns_.load());
   receipt_ns_.store(other.receipt_ns_.load());
   rejected_.store(other.rejected_.load());
+  superseded_.store(other.superseded_.load());
   skew_.store(other.skew_.load());
   return *this;
 }
@@ -48,6 +49,7 @@ bool InputTimeline::checkHeader(const std::string& frame_id, std::int64_t stamp_
   offset_ns_ = correction_.offsetFor(stamp_ns, now_ns);
   const bool admitted = guard_.checkHeader(frame_id, stamp_ns, now_ns - offset_ns_);
   rejected_.store(guard_.rejected(), std::memory_order_relaxed);
+  superseded_.store(guard_.superseded(), std::memory_order_relaxed);
   return admitted;
 }
 

@@ -1,8 +1,10 @@
 // InputTimeline: one input's admission (verdicts), its stamps on this clock, jumps back of the
 // receiver's clock and its age; TimeJumpWatch. No master.
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -174,6 +176,104 @@ TEST(InputTimeline, EstimatedOffsetCorrectsStampsAndNeverGoesBack) {
   EXPECT_EQ(t.accept(), kT0 + 8 * kMs + 1);
   // Stamped after its receipt: its age counts from the receipt.
   EXPECT_NEAR(t.age(kT0 + 10 * kMs), 0.006, 1e-9);
+}
+
+/// A clock of the log intervals the tests move by hand.
+InputGuard::Clock::time_point log_now;
+InputGuard::Clock::time_point logClock() { return log_now; }
+
+/// A state stream's timeline: older stamps superseded, not refused.
+InputTimeline stateTimeline() {
+  InputTimelineOptions o = optionsOf();
+  o.limits.max_future_stamp = 0.25;
+  o.limits.supersede_older = true;
+  return InputTimeline("odom", o, &logClock);
+}
+
+TEST(InputTimeline, AnOlderOrEqualStateIsSupersededNotRefused) {
+  log_now = InputGuard::Clock::time_point{};
+  InputTimeline t = stateTimeline();
+  ASSERT_TRUE(t.checkHeader("world", kT0, kT0));
+  t.accept();
+  EXPECT_FALSE(t.checkHeader("world", kT0 - 10 * kMs, kT0 + kMs));  // reordered
+  EXPECT_TRUE(t.guard().lastSuperseded());
+  EXPECT_FALSE(t.takeLogLine().empty());                     // the first is logged
+  EXPECT_FALSE(t.checkHeader("world", kT0, kT0 + 2 * kMs));  // one stamp twice (bursty clock)
+  EXPECT_TRUE(t.guard().lastSuperseded());
+  EXPECT_TRUE(t.takeLogLine().empty());
+  EXPECT_EQ(t.rejected(), 0u);
+  EXPECT_EQ(t.superseded(), 2u);
+  EXPECT_EQ(t.guard().lastRejection(), "");
+  // The age is the latest accepted one's; a newer stamp is accepted.
+  EXPECT_NEAR(t.age(kT0 + 2 * kMs), 0.002, 1e-12);
+  ASSERT_TRUE(t.checkHeader("world", kT0 + 10 * kMs, kT0 + 10 * kMs));
+  EXPECT_FALSE(t.guard().lastSuperseded());
+  t.accept();
+  // The other checks come first: a stale or zero stamp is still a refusal.
+  EXPECT_FALSE(t.checkHeader("world", 0, kT0 + 20 * kMs));
+  EXPECT_FALSE(t.guard().lastSuperseded());
+  EXPECT_EQ(t.guard().lastKind(), Rejection::kZeroStamp);
+  EXPECT_EQ(t.rejected(), 1u);
+  EXPECT_EQ(t.superseded(), 2u);
+}
+
+TEST(InputTimeline, AShuffledFloodOfStatesWritesAtMostOneLinePerSummaryPeriod) {
+  log_now = InputGuard::Clock::time_point{};
+  InputTimeline t = stateTimeline();
+  // 2000 states 10 ms apart, each pair of neighbours swapped (as two publishing threads do),
+  // and every tenth sent twice (a clock standing still between physics steps).
+  int lines = 0;
+  std::uint64_t accepted = 0;
+  std::uint64_t sent = 0;
+  for (int i = 0; i < 2000; i += 2) {
+    const bool twice = i % 20 == 0;
+    for (const int k : {i + 1, i, twice ? i + 1 : -1}) {
+      if (k < 0) {
+        continue;
+      }
+      ++sent;
+      if (t.checkHeader("world", kT0 + k * 10 * kMs, kT0 + (i + 1) * 10 * kMs + kMs)) {
+        t.accept();
+        ++accepted;
+      }
+      lines += t.takeLogLine().empty() ? 0 : 1;
+    }
+    log_now += std::chrono::milliseconds(20);
+  }
+  // 20 s of steady time: the first line and none after (the summary period is 60 s).
+  EXPECT_EQ(lines, 1);
+  EXPECT_EQ(t.rejected(), 0u);
+  EXPECT_EQ(accepted, 1000u);
+  EXPECT_EQ(sent, 2100u);
+  EXPECT_EQ(t.superseded(), 1100u);
+  log_now += InputGuard::kSummaryPeriod;
+  EXPECT_FALSE(t.checkHeader("world", kT0 + 19980 * kMs, kT0 + 20 * kSecond));
+  EXPECT_TRUE(t.guard().lastSuperseded());
+  const std::string line = t.takeLogLine();
+  EXPECT_NE(line.find("1100 messages"), std::string::npos) << line;
+}
+
+TEST(InputTimeline, AStateAheadOfTheClockSupersedesForAtMostMaxFutureStamp) {
+  InputTimeline t = stateTimeline();
+  // Stamped one 100 ms physics step ahead of this clock (its /clock lags by one burst).
+  ASSERT_TRUE(t.checkHeader("world", kT0 + 100 * kMs, kT0));
+  t.accept();
+  EXPECT_FALSE(t.checkHeader("world", kT0 + 50 * kMs, kT0 + 60 * kMs));
+  EXPECT_TRUE(t.guard().lastSuperseded());
+  ASSERT_TRUE(t.checkHeader("world", kT0 + 110 * kMs, kT0 + 110 * kMs));
+  t.accept();
+  // Beyond max_future_stamp: a refusal, which does not move the order check.
+  EXPECT_FALSE(t.checkHeader("world", kT0 + 10 * kSecond, kT0 + 120 * kMs));
+  EXPECT_EQ(t.guard().lastKind(), Rejection::kFuture);
+  EXPECT_TRUE(t.checkHeader("world", kT0 + 130 * kMs, kT0 + 130 * kMs));
+}
+
+TEST(InputTimeline, AfterAJumpBackOlderStatesAreNewAgain) {
+  InputTimeline t = stateTimeline();
+  ASSERT_TRUE(t.checkHeader("world", kT0, kT0));
+  t.accept();
+  EXPECT_TRUE(t.checkHeader("world", kT0 - 10 * kSecond, kT0 - 10 * kSecond));
+  EXPECT_EQ(t.superseded(), 0u);
 }
 
 }  // namespace

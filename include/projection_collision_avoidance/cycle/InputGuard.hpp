@@ -29,6 +29,12 @@ struct InputGuardLimits {
   std::string required_frame;
   double max_future_stamp = 0;  ///< s a stamp may lie ahead of the receiver's clock (offsets)
   double max_age = 0;           ///< s a message may be old when it arrives; <= 0: no limit
+  /// A stamp not after the last accepted one is superseded, not refused: dropped, counted in
+  /// superseded() and logged at most once per kSummaryPeriod. For streams of a sender's state
+  /// (odometry, positions), where a message older than the latest carries nothing newer (a
+  /// bridge that publishes from several threads, a bursty simulated clock); false: refused as
+  /// out of order or repeated (the package's own measurements, broadcasts and commands).
+  bool supersede_older = false;
 };
 
 /// Admission of the messages of one input topic, free of ROS: stamps are ns since the epoch
@@ -46,6 +52,12 @@ struct InputGuardLimits {
 /// never negative while the clock runs forward. When the receiver's clock jumps back, call
 /// restartTimeline(): the inputs of the old timeline are forgotten (no age, so stale), while
 /// everAccepted() still tells that the input was heard.
+///
+/// With InputGuardLimits::supersede_older, a message stamped at or before the last accepted one
+/// is superseded instead: checkHeader() returns false without a refusal (lastSuperseded()), the
+/// count superseded() grows, and a log line is due for the first one and then at most once per
+/// @ref kSummaryPeriod, with the count since the line before. A stamp accepted ahead of the
+/// clock supersedes the messages after it for at most max_future_stamp.
 class InputGuard {
  public:
   /// Length to which a frame_id (or other text a sender controls) is cut when quoted (bytes).
@@ -65,8 +77,9 @@ class InputGuard {
              Clock::time_point (*clock)() = &Clock::now);
 
   /// Checks a header at the receiver's time @p now_ns: frame, zero stamp, future, stale, order.
-  /// Returns false after counting a refusal (see takeLogLine()); on true the caller checks the
-  /// content and calls accept() or reject().
+  /// Returns false after counting a refusal or, with supersede_older, a superseded message
+  /// (lastSuperseded(); see takeLogLine()); on true the caller checks the content and calls
+  /// accept() or reject().
   bool checkHeader(const std::string& frame_id, std::int64_t stamp_ns, std::int64_t now_ns);
 
   /// Counts a refusal of @p kind; @p detail (cut to kMaxReasonLength) says what was wrong.
@@ -93,6 +106,10 @@ class InputGuard {
   std::uint64_t accepted() const { return accepted_; }
   /// Refusals since start.
   std::uint64_t rejected() const { return rejected_; }
+  /// Messages superseded since start (supersede_older: stamped at or before the last accepted).
+  std::uint64_t superseded() const { return superseded_; }
+  /// The latest checkHeader() returned false because its message was superseded.
+  bool lastSuperseded() const { return last_superseded_; }
   /// Kind of the latest refusal (kContent before any).
   Rejection lastKind() const { return kind_; }
   /// Refusals of the current kind since it began.
@@ -113,14 +130,22 @@ class InputGuard {
   Clock::time_point (*clock_)() = &Clock::now;
   std::uint64_t accepted_ = 0;
   std::uint64_t rejected_ = 0;
-  Rejection kind_ = Rejection::kContent;  ///< kind of the latest refusal
-  std::uint64_t run_length_ = 0;          ///< refusals of kind_ in a row (accepts ignored)
+  std::uint64_t superseded_ = 0;
+  bool last_superseded_ = false;
+  bool have_logged_superseded_ = false;
+  Clock::time_point last_superseded_log_;
+  std::uint64_t unlogged_superseded_ = 0;  ///< superseded since its last log line
+  Rejection kind_ = Rejection::kContent;   ///< kind of the latest refusal
+  std::uint64_t run_length_ = 0;           ///< refusals of kind_ in a row (accepts ignored)
   bool have_logged_ = false;
   Rejection logged_kind_ = Rejection::kContent;  ///< kind of the last log line
   Clock::time_point last_log_;
   std::uint64_t unlogged_ = 0;  ///< refusals since the last log line
   std::string last_rejection_;
   std::string log_line_;
+
+  /// Counts a superseded message and sets the log line when one is due.
+  void supersede();
 };
 
 /// @p text cut to @p length characters, with the original length appended when cut.

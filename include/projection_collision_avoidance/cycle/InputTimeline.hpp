@@ -69,8 +69,9 @@ class InputTimeline {
 
   /// Judges a header (frame_id @p frame_id, stamp @p stamp_ns) received at @p now_ns: notes
   /// the time (with watch_time), takes the offset for the stamp, then the InputGuard checks at
-  /// now − offset. False after counting a refusal (guard().lastKind(), takeLogLine()); on true
-  /// the caller checks the content and calls accept() or reject().
+  /// now − offset. False after counting a refusal (guard().lastKind(), takeLogLine()) or a
+  /// superseded message (guard().lastSuperseded()); on true the caller checks the content and
+  /// calls accept() or reject().
   bool checkHeader(const std::string& frame_id, std::int64_t stamp_ns, std::int64_t now_ns);
 
   /// Takes a message without a header (geometry_msgs/Twist, say) received at @p now_ns: notes
@@ -107,6 +108,9 @@ class InputTimeline {
   std::int64_t stamp() const { return stamp_ns_.load(std::memory_order_relaxed); }
   /// Refusals since start. Any thread.
   std::uint64_t rejected() const { return rejected_.load(std::memory_order_relaxed); }
+  /// Messages superseded since start (InputGuardLimits::supersede_older), not refusals. Any
+  /// thread.
+  std::uint64_t superseded() const { return superseded_.load(std::memory_order_relaxed); }
   /// The latest accepted message's skew, receipt − stamp (s, the raw stamp); NaN before one.
   /// Any thread.
   double skew() const { return skew_.load(std::memory_order_relaxed); }
@@ -131,6 +135,7 @@ class InputTimeline {
   std::atomic<std::int64_t> stamp_ns_{0};
   std::atomic<std::int64_t> receipt_ns_{kNone};
   std::atomic<std::uint64_t> rejected_{0};
+  std::atomic<std::uint64_t> superseded_{0};
   std::atomic<double> skew_{std::numeric_limits<double>::quiet_NaN()};
 };
 

@@ -4,6 +4,7 @@
 #include <mutex>
 #include <string>
 
+#include <diagnostic_updater/diagnostic_updater.h>
 #include <geometry_msgs/AccelStamped.h>
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
@@ -36,8 +37,9 @@ struct CommandAdapterOptions;
 /// stands still) every output gets its stop (zero velocity, zero v and ω, a braking
 /// acceleration), again at every check until commands return. Commands that are non-finite, act
 /// on an axis the model lacks, or are stamped 0, in the future or not after the last one, are
-/// refused and counted (InputTimeline); so are non-finite odometry messages. No input ends the
-/// node.
+/// refused and counted (InputTimeline); so are non-finite odometry messages; an odometry stamped
+/// at or before the latest accepted one is superseded (dropped, counted apart). The counts are in
+/// `/diagnostics`. No input ends the node.
 class CommandAdapter {
  public:
   /// @throws ParameterError naming the key of an invalid option
@@ -50,6 +52,8 @@ class CommandAdapter {
   void onCommand(const geometry_msgs::AccelStamped::ConstPtr& msg);
   void onOdometry(const nav_msgs::Odometry::ConstPtr& msg);
   void onWatchdog(const ros::SteadyTimerEvent& event);
+  /// The counts of both inputs for `/diagnostics` (mutex_ held).
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
   /// Publishes @p command on every chosen output, stamped @p stamp (mutex_ held).
   void publish(const ConvertedCommand& command, const ros::Time& stamp);
 
@@ -63,6 +67,10 @@ class CommandAdapter {
   std::string world_frame_;  ///< ~world_frame, or the own odometry's header.frame_id
   std::string base_frame_;   ///< ~base_frame, or the own odometry's child_frame_id
   Eigen::VectorXd acceleration_;
+  bool warned_no_base_frame_ = false;
+  /// `/diagnostics` at 1 Hz of ROS time, from the watchdog's timer: accepted, rejected and
+  /// superseded messages of `command` and `odom`.
+  diagnostic_updater::Updater diagnostics_;
 
   tf2_ros::Buffer tf_buffer_;
   std::unique_ptr<tf2_ros::TransformListener> tf_listener_;

@@ -21,6 +21,7 @@ struct LeaderNodeOptions {
   double rate = 0.0;                    ///< Hz
   std::string leader_frame = "leader";  ///< frame_id of the command
   bool share_disturbance = true;        ///< put u_d(t) in the broadcast (empty otherwise)
+  double max_future_stamp = 0.25;       ///< s an odometry stamp may lie ahead of the clock
 };
 
 /// The leader: plays the scenario's input profile u_1(t) and tells its followers about itself.
@@ -51,11 +52,9 @@ class LeaderNode {
   Eigen::VectorXd state_;        ///< its [p; v]
   bool have_odometry_ = false;
   bool odometry_fresh_ = false;  ///< an odometry not broadcast yet
-  /// s by which an odometry stamp may lie ahead of the leader's clock
-  static constexpr double kMaxFutureStamp = 0.1;
-  /// Restarted by the ticks when ROS time goes back (tick_time_).
-  InputTimeline odometry_timeline_{"leader/odom",
-                                   InputTimelineOptions{{"", kMaxFutureStamp, 0.0}, {}, false}};
+  /// Restarted by the ticks when ROS time goes back (tick_time_); an odometry older than the
+  /// latest accepted is superseded.
+  InputTimeline odometry_timeline_;
   TimeJumpWatch tick_time_;  ///< ROS time of the ticks published
   bool started_ = false;
   ros::Time origin_;      ///< ROS time of scenario time 0

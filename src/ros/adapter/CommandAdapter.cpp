@@ -44,11 +44,14 @@ CommandAdapter::CommandAdapter(ros::NodeHandle nh, ros::NodeHandle private_nh)
       options_(readOptions(private_nh)),
       converter_(options_->converter),
       watchdog_(options_->command_timeout),
-      command_timeline_("command", InputGuardLimits{"", 0.1, options_->command_timeout}),
-      odometry_timeline_("odom", InputGuardLimits{"", 0.1, 0.0}),
+      command_timeline_(
+          "command", InputGuardLimits{"", options_->max_future_stamp, options_->command_timeout}),
+      // A state stream: an odometry older than the latest accepted is superseded.
+      odometry_timeline_("odom", InputGuardLimits{"", options_->max_future_stamp, 0.0, true}),
       world_frame_(options_->world_frame),
       base_frame_(options_->base_frame),
-      acceleration_(Eigen::VectorXd::Zero(options_->converter.axes)) {
+      acceleration_(Eigen::VectorXd::Zero(options_->converter.axes)),
+      diagnostics_(nh, private_nh, name_) {
   if (options_->accel_enu) {
     accel_publisher_ = nh.advertise<geometry_msgs::Vector3Stamped>("setpoint_accel", 10);
   }
@@ -63,6 +66,8 @@ CommandAdapter::CommandAdapter(ros::NodeHandle nh, ros::NodeHandle private_nh)
                                       ros::TransportHints().tcpNoDelay());
   command_subscriber_ = nh.subscribe("command", 10, &CommandAdapter::onCommand, this,
                                      ros::TransportHints().tcpNoDelay());
+  diagnostics_.setHardwareID(name_);
+  diagnostics_.add("command adapter", this, &CommandAdapter::diagnose);
   watchdog_timer_ = nh.createSteadyTimer(ros::WallDuration(1.0 / options_->watchdog_rate),
                                          &CommandAdapter::onWatchdog, this);
   ROS_INFO_STREAM(name_ << ": " << (options_->accel_enu ? "setpoint_accel " : "")
@@ -101,8 +106,15 @@ void CommandAdapter::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
       return;
     }
     odometry_timeline_.accept();
-    if (options_->base_frame.empty()) {
+    if (options_->base_frame.empty() && !msg->child_frame_id.empty()) {
       base_frame_ = tfFrame(msg->child_frame_id);
+    } else if (base_frame_.empty() && options_->twist_stamped && !warned_no_base_frame_) {
+      // REP 105 names the twist's frame in child_frame_id; empty, the twist is taken as the
+      // body's (~odometry/twist_frame body), whose name only ~base_frame can give.
+      warned_no_base_frame_ = true;
+      ROS_WARN_STREAM(name_ << ": the odometry's child_frame_id is empty: its twist is taken in "
+                               "the body frame, and cmd_vel_stamped in the base frame carries an "
+                               "empty frame_id until ~base_frame names it");
     }
     world_frame_ =
         options_->world_frame.empty() ? tfFrame(msg->header.frame_id) : options_->world_frame;
@@ -137,6 +149,7 @@ void CommandAdapter::onCommand(const geometry_msgs::AccelStamped::ConstPtr& msg)
 
 void CommandAdapter::onWatchdog(const ros::SteadyTimerEvent& /*event*/) {
   const std::lock_guard<std::mutex> lock(mutex_);
+  diagnostics_.update();
   const WatchdogDecision decision = watchdog_.check(steadySeconds());
   if (!decision.send_stop) {
     return;
@@ -147,6 +160,26 @@ void CommandAdapter::onWatchdog(const ros::SteadyTimerEvent& /*event*/) {
   }
   const ros::Time now = ros::Time::now();
   publish(converter_.stop(now.toSec()), now);
+}
+
+void CommandAdapter::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  // Called from onWatchdog() (diagnostics_.update()) with mutex_ held.
+  using diagnostic_msgs::DiagnosticStatus;
+  const std::string& command_rejection = command_timeline_.guard().lastRejection();
+  const std::string& odometry_rejection = odometry_timeline_.guard().lastRejection();
+  status.summary(DiagnosticStatus::OK, "converting commands");
+  if (!command_rejection.empty()) {
+    status.mergeSummary(DiagnosticStatus::WARN, "rejecting commands: " + command_rejection);
+  }
+  if (!odometry_rejection.empty()) {
+    status.mergeSummary(DiagnosticStatus::WARN, "rejecting odometry: " + odometry_rejection);
+  }
+  status.add("accepted_commands", command_timeline_.guard().accepted());
+  status.add("rejected_commands", command_timeline_.rejected());
+  status.add("accepted_odometry", odometry_timeline_.guard().accepted());
+  status.add("rejected_odometry", odometry_timeline_.rejected());
+  status.add("superseded_odometry", odometry_timeline_.superseded());
+  status.add("max_future_stamp (s)", options_->max_future_stamp);
 }
 
 void CommandAdapter::publish(const ConvertedCommand& command, const ros::Time& stamp) {

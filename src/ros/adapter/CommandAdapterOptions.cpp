@@ -9,6 +9,7 @@ namespace projection_collision_avoidance {
 namespace {
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
+constexpr double kDefaultOdometryAge = 0.25;  ///< s, ~odometry/max_age
 
 /// A limit where 0 means none (infinity).
 double limitOrNone(NodeOptionReader& reader, const std::string& key, double max) {
@@ -70,7 +71,11 @@ CommandAdapterOptions readCommandAdapterOptions(NodeOptionReader& reader) {
   options.command_timeout =
       reader.number("command_timeout", options.command_timeout, c.period, 3600.0);
   options.watchdog_rate = reader.number("watchdog_rate", options.watchdog_rate, 0.1, 1e4);
-  c.max_odometry_age = reader.number("odometry/max_age", c.max_odometry_age, 0.0, 3600.0);
+  options.max_future_stamp =
+      reader.number("max_future_stamp", options.max_future_stamp, 0.0, 3600.0);
+  // An odometry stays usable over one 100 ms burst of a simulated /clock and the delay of the
+  // next (doc/boundary.md).
+  c.max_odometry_age = reader.number("odometry/max_age", kDefaultOdometryAge, 0.0, 3600.0);
   c.odometry_twist_frame = twistFrameOf(reader.text("odometry/twist_frame", "body"));
   c.velocity.max_speed = limitOrNone(reader, "velocity/max_speed", 1e4);
   c.velocity.velocity_lag = reader.number("velocity/lag", 0.0, 0.0, 3600.0);

@@ -16,6 +16,9 @@ struct CommandAdapterOptions {
   CommandConverterOptions converter;
   double command_timeout = 0.25;  ///< steady s without a command before the stop is sent
   double watchdog_rate = 20.0;    ///< Hz (steady time) of the timeout checks and repeated stops
+  /// s a command's or an odometry's stamp may lie ahead of this node's clock (two 100 ms bursts
+  /// of a simulated /clock and 50 ms of transport; doc/boundary.md)
+  double max_future_stamp = 0.25;
   std::string base_frame;  ///< frame_id of base-frame stamped outputs ("": the odometry's child)
   /// The follower's world frame (its measurements' frame); "": the own odometry's header frame.
   std::string world_frame;
@@ -23,7 +26,7 @@ struct CommandAdapterOptions {
 
 /// The options, each validated (the message names the key): ~outputs (a space-separated set of
 /// accel_enu, twist, twist_stamped, unicycle; twist and unicycle both publish cmd_vel and are
-/// refused together), ~axes, ~control_rate, ~command_timeout, ~watchdog_rate,
+/// refused together), ~axes, ~control_rate, ~command_timeout, ~watchdog_rate, ~max_future_stamp,
 /// ~odometry/max_age, ~odometry/twist_frame, ~velocity/max_speed, ~velocity/lag,
 /// ~velocity/frame, ~unicycle/look_ahead, ~unicycle/max_speed, ~unicycle/max_yaw_rate,
 /// ~stop_deceleration, ~base_frame, ~world_frame.

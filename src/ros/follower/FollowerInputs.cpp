@@ -24,9 +24,9 @@ FollowerInputs::FollowerInputs(std::string node_name, const FollowerNodeOptions&
       leader_timeline_("leader_broadcast", {{options.leader_broadcast_frame,
                                              options.max_future_stamp, options.leader_timeout},
                                             options.clock_skew}),
-      // The own odometry: stamps as they are.
+      // The own odometry: stamps as they are; an older one than the latest is superseded.
       odometry_timeline_("odom", InputGuardLimits{options.odom_frame, options.max_future_stamp,
-                                                  options.measurement_timeout}) {
+                                                  options.measurement_timeout, true}) {
   measurement_.relative_state.setZero(2 * axes_);
   leader_.acceleration.setZero(axes_);
   own_state_.state.setZero(2 * axes_);
@@ -62,11 +62,13 @@ FollowerInputStats FollowerInputs::stats(std::int64_t now_ns) const {
   stats.rejected_measurements = measurement_timeline_.rejected();
   stats.rejected_leader_broadcasts = leader_timeline_.rejected();
   stats.rejected_odometry = odometry_timeline_.rejected();
+  stats.superseded_odometry = odometry_timeline_.superseded();
   stats.measurement_skew = measurement_timeline_.skew();
   stats.leader_skew = leader_timeline_.skew();
   stats.clock_offset = clock_offset_.load(std::memory_order_relaxed);
   if (const MeasurementAdapter* adapter = adapter_.load(std::memory_order_acquire)) {
     stats.rejected_input = adapter->rejected();
+    stats.superseded_input = adapter->superseded();
     stats.input_skew = adapter->skew();
   }
   const std::lock_guard<std::mutex> lock(reasons_mutex_);

@@ -30,13 +30,15 @@ struct FollowerInputStats {
   std::uint64_t rejected_measurements = 0;
   std::uint64_t rejected_leader_broadcasts = 0;
   std::uint64_t rejected_odometry = 0;
-  std::string measurement_rejection;  ///< the latest, "" once one was accepted after it
+  std::uint64_t superseded_odometry = 0;  ///< own odometry older than the latest: dropped
+  std::string measurement_rejection;      ///< the latest, "" once one was accepted after it
   std::string leader_rejection;
   /// s, of the last accepted measurement (InputTimeline::age()); +inf: none on this timeline
   double measurement_age = kNoInputAge;
-  double leader_age = kNoInputAge;   ///< s, of the last accepted leader broadcast; +inf: none
-  std::uint64_t rejected_input = 0;  ///< messages the input adapter refused (~input not
-                                     ///< relative_measurement)
+  double leader_age = kNoInputAge;     ///< s, of the last accepted leader broadcast; +inf: none
+  std::uint64_t rejected_input = 0;    ///< messages the input adapter refused (~input not
+                                       ///< relative_measurement)
+  std::uint64_t superseded_input = 0;  ///< the input adapter's messages dropped as superseded
   /// s, the skew of the adapter's latest accepted input (its two stamps apart); NaN: none, as
   /// the other skews
   double input_skew = std::numeric_limits<double>::quiet_NaN();

@@ -79,9 +79,11 @@ constexpr int kMaxControlPriority = 99;
 
 /// The follower node's own options (besides the scenario), read once from its private namespace.
 struct FollowerNodeOptions {
-  double measurement_timeout = 0.5;    ///< s; an older measurement puts the follower in fallback
-  double leader_timeout = 0.5;         ///< s; an older leader broadcast is not used
-  double max_future_stamp = 0.1;       ///< s; inputs stamped after now + this are refused
+  double measurement_timeout = 0.5;  ///< s; an older measurement puts the follower in fallback
+  double leader_timeout = 0.5;       ///< s; an older leader broadcast is not used
+  /// s; inputs stamped after now + this are refused. 0.25: two 100 ms bursts of a simulated
+  /// /clock and 50 ms of transport (doc/boundary.md, "Stamp tolerances").
+  double max_future_stamp = 0.25;
   bool use_leader_broadcast = false;   ///< use u_1 from leader_broadcast (always monitored)
   std::string measurement_frame;       ///< required frame_id of measurements ("" = any)
   std::string leader_broadcast_frame;  ///< required frame_id of leader broadcasts ("" = any)

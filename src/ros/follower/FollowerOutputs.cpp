@@ -234,8 +234,10 @@ void FollowerOutputs::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat
   status.add("time_headway (s)", s.time_headway);
   status.add("own_state_fresh", s.own_state_fresh);
   status.add("rejected_odometry", inputs.rejected_odometry);
+  status.add("superseded_odometry", inputs.superseded_odometry);
   status.add("input", toString(options_.input));
   status.add("rejected_input_messages", inputs.rejected_input);
+  status.add("superseded_input_messages", inputs.superseded_input);
   status.add("input_skew (s)", inputs.input_skew);
   status.add("measurement_age (s)", inputs.measurement_age);
   status.add("measurement_skew (s)", inputs.measurement_skew);

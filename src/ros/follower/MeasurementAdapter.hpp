@@ -28,6 +28,9 @@ class MeasurementAdapter {
   virtual void start(ros::NodeHandle nh) = 0;
   /// Messages (and pairs, lookups) refused so far, for the diagnostics (any thread).
   virtual std::uint64_t rejected() const = 0;
+  /// Messages dropped as superseded so far: stamped at or before the latest accepted one of their
+  /// topic (doc/boundary.md), not refusals (any thread).
+  virtual std::uint64_t superseded() const { return 0; }
   /// The latest |t_target − t_self| of two samples combined (s); NaN when not applicable.
   virtual double skew() const { return std::numeric_limits<double>::quiet_NaN(); }
   /// The world frame and the world position (m) of the own controlled point; false when this

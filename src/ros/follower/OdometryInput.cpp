@@ -33,11 +33,12 @@ OdometryInput::OdometryInput(std::string node_name, const FollowerNodeOptions& o
       sink_(std::move(sink)),
       relative_(alignmentOptions(options.odometry, axes)),
       world_frame_(options.measurement_frame),
-      // A message older than the measurement timeout on arrival could only be stale.
+      // A message older than the measurement timeout on arrival could only be stale; one older
+      // than the latest accepted of its topic is superseded (doc/boundary.md).
       self_("odom", InputGuardLimits{options.odom_frame, options.max_future_stamp,
-                                     options.measurement_timeout}),
+                                     options.measurement_timeout, true}),
       target_("target_odom",
-              InputGuardLimits{"", options.max_future_stamp, options.measurement_timeout}),
+              InputGuardLimits{"", options.max_future_stamp, options.measurement_timeout, true}),
       skew_(std::numeric_limits<double>::quiet_NaN()) {
   pair_guard_ = InputGuard("odometry pair", {"", options.max_future_stamp, 3600.0});
 }

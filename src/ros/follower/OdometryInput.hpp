@@ -47,6 +47,10 @@ class OdometryInput : public MeasurementAdapter {
     return rejected_.load(std::memory_order_relaxed) +
            rejected_pairs_.load(std::memory_order_relaxed);
   }
+  /// Odometry messages superseded so far (both topics): stamped at or before the latest accepted.
+  std::uint64_t superseded() const override {
+    return self_.timeline.superseded() + target_.timeline.superseded();
+  }
   /// The world frame and the world position (m) of the own controlled point at the latest own
   /// odometry; false before one.
   bool controlledPoint(std::string* frame, Eigen::Vector3d* point) override;

@@ -38,10 +38,11 @@ PositionInput::PositionInput(std::string node_name, const FollowerNodeOptions& o
       axes_(axes),
       sink_(std::move(sink)),
       filter_(makeFilter(options.position, axes)),
-      point_timeline_("target_position",
-                      InputGuardLimits{"", options.max_future_stamp, options.measurement_timeout}),
-      pose_timeline_("target_pose",
-                     InputGuardLimits{"", options.max_future_stamp, options.measurement_timeout}),
+      // Positions are a state stream: an older one than the latest is superseded.
+      point_timeline_("target_position", InputGuardLimits{"", options.max_future_stamp,
+                                                          options.measurement_timeout, true}),
+      pose_timeline_("target_pose", InputGuardLimits{"", options.max_future_stamp,
+                                                     options.measurement_timeout, true}),
       tf_timeline_("tf lookup",
                    InputGuardLimits{"", options.max_future_stamp, options.measurement_timeout}),
       skew_(std::numeric_limits<double>::quiet_NaN()) {}

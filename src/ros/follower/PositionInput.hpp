@@ -40,6 +40,10 @@ class PositionInput : public MeasurementAdapter {
 
   void start(ros::NodeHandle nh) override;
   std::uint64_t rejected() const override { return rejected_.load(std::memory_order_relaxed); }
+  /// Positions superseded (stamped at or before the latest accepted one of their topic).
+  std::uint64_t superseded() const override {
+    return point_timeline_.superseded() + pose_timeline_.superseded();
+  }
   double skew() const override { return skew_.load(std::memory_order_relaxed); }
   bool controlledPoint(std::string* frame, Eigen::Vector3d* point) override;
 

@@ -21,6 +21,7 @@ LeaderNodeOptions readOptions(NodeOptionReader& reader, const Scenario& scenario
     throw ParameterError("~leader_frame", "must not be empty");
   }
   o.share_disturbance = reader.boolean("share_disturbance", o.share_disturbance);
+  o.max_future_stamp = reader.number("max_future_stamp", o.max_future_stamp, 0.0, 3600.0);
   return o;
 }
 
@@ -33,6 +34,8 @@ LeaderNode::LeaderNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
       axes_(scenario_.controller.model.double_integrator_axes) {
   NodeOptionReader reader(private_nh);
   options_ = readOptions(reader, scenario_);
+  odometry_timeline_ = InputTimeline(
+      "leader/odom", InputTimelineOptions{{"", options_.max_future_stamp, 0.0, true}, {}, false});
   echoScenario(name_, private_nh);
   reader.echo(name_);
 
