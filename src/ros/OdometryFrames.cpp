@@ -12,7 +12,7 @@ namespace projection_collision_avoidance {
 
 bool odometryInFrame(const nav_msgs::Odometry& msg, const std::string& world_frame,
                      bool twist_in_body_frame, const tf2_ros::Buffer& tf_buffer, double tf_timeout,
-                     OdometrySample* sample, std::string* why) {
+                     const std::string& frame_key, OdometrySample* sample, std::string* why) {
   *sample = toOdometrySample(msg);
   if (world_frame.empty() || sameFrame(msg.header.frame_id, world_frame)) {
     return true;
@@ -22,8 +22,12 @@ bool odometryInFrame(const nav_msgs::Odometry& msg, const std::string& world_fra
     transform = tf_buffer.lookupTransform(tfFrame(world_frame), tfFrame(msg.header.frame_id),
                                           msg.header.stamp, ros::Duration(tf_timeout));
   } catch (const tf2::TransformException& error) {
-    *why = "no transform from \"" + boundedText(msg.header.frame_id, InputGuard::kMaxQuotedLength) +
-           "\" to \"" + world_frame + "\": " + error.what();
+    const std::string frame = boundedText(msg.header.frame_id, InputGuard::kMaxQuotedLength);
+    *why = "no transform from \"" + frame + "\" to \"" + world_frame + "\" (" + frame_key +
+           "): publish one (odometry from each robot's start pose: a static transform " +
+           world_frame + " -> " + tfFrame(frame) +
+           " at that start pose; global odometry: the identity), or set " + frame_key +
+           " to a frame both reach: " + error.what();
     return false;
   }
   const Eigen::Isometry3d world_from_frame = tf2::transformToEigen(transform);

@@ -18,9 +18,11 @@ namespace projection_collision_avoidance {
 /// the header frame (@p twist_in_body_frame false), the twist (v_W = R v, ω_W = R ω) moved by the
 /// transform world ← header.frame_id that @p tf_buffer holds at the message's stamp, waiting at
 /// most @p tf_timeout s. A body-frame twist stays as it is (its body now has orientation q_W).
+/// @param frame_key the parameter that names @p world_frame (`~measurement_frame`,
+///        `~world_frame`), named in the reason with the transform to publish
 /// @return false, with the reason in @p why, when there is no such transform
 bool odometryInFrame(const nav_msgs::Odometry& msg, const std::string& world_frame,
                      bool twist_in_body_frame, const tf2_ros::Buffer& tf_buffer, double tf_timeout,
-                     OdometrySample* sample, std::string* why);
+                     const std::string& frame_key, OdometrySample* sample, std::string* why);
 
 }  // namespace projection_collision_avoidance

@@ -96,7 +96,7 @@ void CommandAdapter::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
     std::string why;
     if (!odometryInFrame(*msg, options_->world_frame,
                          options_->converter.odometry_twist_frame == TwistFrame::kBody, tf_buffer_,
-                         0.0, &sample, &why)) {
+                         0.0, "~world_frame", &sample, &why)) {
       odometry_timeline_.reject(Rejection::kContent, why);
       return;
     }

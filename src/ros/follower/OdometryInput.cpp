@@ -10,6 +10,9 @@
 namespace projection_collision_avoidance {
 namespace {
 
+/// The parameter naming the world frame, in refusals.
+constexpr const char* kFrameKey = "~measurement_frame";
+
 OdometryAlignmentOptions alignmentOptions(const OdometryInputOptions& o, int axes) {
   OdometryAlignmentOptions a;
   a.axes = axes;
@@ -71,10 +74,20 @@ void OdometryInput::onOdometry(Side* side, const nav_msgs::Odometry::ConstPtr& m
     if (side == &self_ && options_.measurement_frame.empty()) {
       world_frame_ = tfFrame(msg->header.frame_id);  // the own odometry's frame is the world
     }
+    if (options_.measurement_frame.empty() && !world_frame_.empty() && !warned_frames_ &&
+        !sameFrame(msg->header.frame_id, world_frame_)) {
+      warned_frames_ = true;  // the two odometries are in different frames: tf2 must join them
+      ROS_WARN_STREAM(name_ << ": odom is in \"" << world_frame_ << "\", target_odom in \""
+                            << boundedText(msg->header.frame_id, InputGuard::kMaxQuotedLength)
+                            << "\": moved into the first with tf2; set ~measurement_frame to "
+                               "the frame both robots' odometry frames reach (their starts "
+                               "placed by tf), as odometry from different start poses has no "
+                               "common origin otherwise");
+    }
     std::string why;
     OdometrySample sample;
     if (!odometryInFrame(*msg, world_frame_, options_.odometry.twist_in_body_frame, tf_buffer_,
-                         options_.odometry.tf_timeout, &sample, &why)) {
+                         options_.odometry.tf_timeout, kFrameKey, &sample, &why)) {
       timeline.reject(Rejection::kContent, why);
       return;
     }
@@ -115,7 +128,7 @@ void OdometryInput::combine() {
     std::string why;
     OdometrySample sample;
     if (!odometryInFrame(*target_.msg, world_frame_, options_.odometry.twist_in_body_frame,
-                         tf_buffer_, options_.odometry.tf_timeout, &sample, &why)) {
+                         tf_buffer_, options_.odometry.tf_timeout, kFrameKey, &sample, &why)) {
       rejected_pairs_.fetch_add(1, std::memory_order_relaxed);
       pair_guard_.reject(Rejection::kContent, "the target's odometry: " + why);
       logRejection(pair_guard_, name_);

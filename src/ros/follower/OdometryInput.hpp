@@ -78,7 +78,8 @@ class OdometryInput : public MeasurementAdapter {
   int axes_;
   Sink sink_;
   RelativeStateFromOdometry relative_;
-  std::string world_frame_;  ///< ~measurement_frame, else the latest own odometry's frame
+  std::string world_frame_;     ///< ~measurement_frame, else the latest own odometry's frame
+  bool warned_frames_ = false;  ///< the odometries' frames differ without ~measurement_frame
 
   std::mutex mutex_;  ///< the two subscriptions may call at once (nodelets)
   Side self_;
