@@ -23,6 +23,7 @@ import rosnode
 import rospy
 import rostest
 from geometry_msgs.msg import AccelStamped, PointStamped, PoseStamped, Twist, TwistStamped
+from diagnostic_msgs.msg import DiagnosticArray
 from nav_msgs.msg import Odometry
 from projection_collision_avoidance.msg import FollowerStatus
 
@@ -57,6 +58,27 @@ class HostileVehicleInputs(unittest.TestCase):
         rospy.Subscriber("/follower/status", FollowerStatus, cls.keep(cls.statuses))
         rospy.Subscriber("/adapter/cmd_vel", Twist, cls.keep(cls.twists))
         rospy.Subscriber("/follower/odom", Odometry, cls.keep(cls.plant_odometry))
+        cls.diagnostics = {}  # status name -> {key: value}, the latest
+        rospy.Subscriber("/diagnostics", DiagnosticArray, cls.on_diagnostics, queue_size=100)
+
+    @classmethod
+    def on_diagnostics(cls, msg):
+        with cls.lock:
+            for status in msg.status:  # named "<node>: <task>", the node's leading slash or not
+                node = status.name.split(":")[0].lstrip("/")
+                cls.diagnostics[node] = {v.key: v.value for v in status.values}
+
+    def counts(self):
+        """(follower's rejected and superseded odometry, adapter's), from the latest
+        diagnostics; None before both were heard."""
+        with self.lock:
+            follower = self.diagnostics.get("follower/controller")
+            adapter = self.diagnostics.get("follower/adapter")
+        if follower is None or adapter is None:
+            return None
+        return (int(follower["rejected_input_messages"]),
+                int(follower["superseded_input_messages"]),
+                int(adapter["rejected_odometry"]), int(adapter["superseded_odometry"]))
 
     @classmethod
     def keep(cls, store):
@@ -202,6 +224,41 @@ class HostileVehicleInputs(unittest.TestCase):
         self.wait_for(driven_stamped, "the plant does not hold a good TwistStamped and refuse one "
                                       "stamped ahead")
 
+
+    def test_reordered_odometry_is_superseded_not_refused(self):
+        """Good odometry on the follower's two topics and the adapter's, every message sent
+        again 5 ms earlier after it and once more as it was (a bridge publishing from two
+        threads, a clock standing still): nothing refused, two superseded per message."""
+        self.wait_for(lambda: self.counts() is not None, "no diagnostics of follower and adapter")
+        # The counts once the earlier test's messages are all judged: two diagnostics (1 Hz)
+        # alike.
+        seen = [self.counts()]
+        def settled():
+            time.sleep(1.5)
+            seen.append(self.counts())
+            return seen[-1] == seen[-2]
+        self.wait_for(settled, "the counts do not settle")
+        before = seen[-1]
+        pairs = 100
+        for _ in range(pairs):
+            now = rospy.Time.now()
+            for publisher, x in ((self.target, 5.0), (self.own, 0.0), (self.adapter_odom, 0.0)):
+                newer = self.good_odometry(x, 0.0)
+                newer.header.stamp = now
+                older = self.good_odometry(x, 0.0)
+                older.header.stamp = now - rospy.Duration(0.005)
+                for msg in (newer, older, newer):
+                    publisher.publish(msg)
+            time.sleep(0.01)
+        expected = (0, 2 * 2 * pairs, 0, 2 * pairs)
+        def counted():
+            after = self.counts()
+            return after is not None and after[1] - before[1] >= expected[1] and \
+                after[3] - before[3] >= expected[3]
+        self.wait_for(counted, "the reordered odometry is not counted as superseded")
+        after = self.counts()
+        self.assertEqual([a - b for a, b in zip(after, before)], list(expected),
+                         "(follower refused, superseded; adapter refused, superseded)")
 
 if __name__ == "__main__":
     rospy.init_node("test_hostile_vehicle_inputs")
