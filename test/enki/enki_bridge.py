@@ -18,6 +18,15 @@ Per robot ``<name>`` (topics relative to the node's namespace):
   * publishes ``<name>/ground_truth`` (nav_msgs/Odometry): world pose, frame_id ``world``,
     child_frame_id ``/<name>/base_link``, twist in the WORLD frame.
 
+Per relative sensor ``{observer, target}`` of ``~relative_sensors`` (a range-and-bearing or
+camera-like sensor on the observer that sees the target's centre):
+  * publishes ``<observer>/relative/<target>`` (geometry_msgs/PointStamped): the target's centre
+    relative to the sensor, in the sensor's frame, at the publish rate with the same fresh stamps;
+    the sensor sits at the observer's centre (frame ``/<observer>/base_link``) or, with a mount
+    offset x, y (m, in the observer's body frame), in frame ``/<observer>/sensor_<target>``, with a
+    static tf ``/<observer>/base_link`` -> it; ``noise`` (m) adds Gaussian noise of that standard
+    deviation to each coordinate.
+
 Private parameters (defaults in brackets):
   ~robots        list of {name, type: thymio2|epuck, x, y (m), heading (rad)}
                  [robot_0 at (0, 0, 0) and robot_1 at (-0.5, 0, 0), both thymio2]
@@ -31,17 +40,20 @@ Private parameters (defaults in brackets):
   ~publish_clock bool, drive /clock in bursts of physics_step [false]
   ~real_time_factor  sim s per wall s with publish_clock; <= 0 = as fast as possible [1]
   ~arena_radius  m, circular walls centred on the origin; 0 = unbounded world [0]
-  ~seed          Enki's random seed (motor noise); < 0 = Enki's own [-1]
+  ~seed          Enki's random seed (motor noise; with >= 0 also the relative sensors'
+                 noise); < 0 = Enki's own [-1]
+  ~relative_sensors  list of {observer, target, x (m) [0], y (m) [0], noise (m) [0]} [[]]
 """
 
 import math
+import random
 import threading
 import time
 
 import pyenki
 import rospy
 import tf2_ros
-from geometry_msgs.msg import Quaternion, TransformStamped, Twist
+from geometry_msgs.msg import PointStamped, Quaternion, TransformStamped, Twist
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
 
@@ -171,6 +183,55 @@ class SimRobot:
         return odom, truth, tf
 
 
+class RelativeSensor:
+    """The target's centre seen from a sensor mounted on the observer (PointStamped)."""
+
+    def __init__(self, spec, robots, rng):
+        names = {robot.name: robot for robot in robots}
+        observer = str(spec["observer"]).strip("/")
+        target = str(spec["target"]).strip("/")
+        if observer not in names or target not in names or observer == target:
+            raise ValueError("relative sensor %r: observer and target must be two of the robots %s"
+                             % (spec, sorted(names)))
+        self.observer, self.target = names[observer], names[target]
+        self.mount = (float(spec.get("x", 0.0)), float(spec.get("y", 0.0)))
+        self.noise = float(spec.get("noise", 0.0))
+        if not all(math.isfinite(v) for v in self.mount) or not self.noise >= 0.0:
+            raise ValueError("relative sensor %r: x, y must be finite and noise >= 0" % (spec,))
+        self.rng = rng
+        mounted = self.mount != (0.0, 0.0)
+        self.frame = ("/%s/sensor_%s" % (observer, target)) if mounted else self.observer.base_frame
+        self.pub = rospy.Publisher("%s/relative/%s" % (observer, target), PointStamped, queue_size=10)
+
+    def mount_transform(self):
+        """The static transform observer base_link -> sensor frame, or None at the centre."""
+        if self.frame == self.observer.base_frame:
+            return None
+        t = TransformStamped()
+        t.header.stamp = rospy.Time.now()
+        t.header.frame_id = self.observer.base_frame
+        t.child_frame_id = self.frame
+        t.transform.translation.x, t.transform.translation.y = self.mount
+        t.transform.rotation.w = 1.0
+        return t
+
+    def message(self, stamp):
+        """The target's centre in the sensor's frame (m), stamped ``stamp``."""
+        x, y, yaw = self.observer.state()[:3]
+        tx, ty = self.target.state()[:2]
+        c, s = math.cos(yaw), math.sin(yaw)
+        dx, dy = tx - x, ty - y
+        msg = PointStamped()
+        msg.header.stamp = stamp
+        msg.header.frame_id = self.frame
+        msg.point.x = c * dx + s * dy - self.mount[0]
+        msg.point.y = -s * dx + c * dy - self.mount[1]
+        if self.noise > 0.0:
+            msg.point.x += self.rng.gauss(0.0, self.noise)
+            msg.point.y += self.rng.gauss(0.0, self.noise)
+        return msg
+
+
 class EnkiBridge:
     """Steps an Enki world on ROS time (or drives /clock) and publishes the robots' state."""
 
@@ -196,13 +257,21 @@ class EnkiBridge:
         names = [r.name for r in self.robots]
         if len(set(names)) != len(names):
             raise ValueError("robot names must be unique: %s" % names)
+        rng = random.Random(seed) if seed >= 0 else random.Random()
+        self.sensors = [RelativeSensor(spec, self.robots, rng)
+                        for spec in rospy.get_param("~relative_sensors", [])]
+        frames = [sensor.frame for sensor in self.sensors]
+        if len(set(frames)) != len(frames):
+            raise ValueError("two relative sensors of one observer look at one target")
         self.tf_broadcaster = tf2_ros.TransformBroadcaster()
         world_frame = str(rospy.get_param("~world_frame", ""))
+        static = [robot.odom_in_world(world_frame, self.odom_global)
+                  for robot in self.robots] if world_frame else []
+        static += [t for t in (sensor.mount_transform() for sensor in self.sensors) if t is not None]
         self.static_broadcaster = None
-        if world_frame:
+        if static:  # one latched message holds them all: a second call would replace the first
             self.static_broadcaster = tf2_ros.StaticTransformBroadcaster()
-            self.static_broadcaster.sendTransform(
-                [robot.odom_in_world(world_frame, self.odom_global) for robot in self.robots])
+            self.static_broadcaster.sendTransform(static)
         rospy.loginfo("enki_bridge: %s, physics_step %.3f s, publish_rate %.1f Hz, %s",
                       ", ".join("%s (%s)" % (r.name, type(r.robot).__name__) for r in self.robots),
                       self.dt, self.publish_rate,
@@ -225,6 +294,8 @@ class EnkiBridge:
             robot.truth_pub.publish(truth)
             transforms.append(tf)
         self.tf_broadcaster.sendTransform(transforms)
+        for sensor in self.sensors:  # after the tf of the same stamp, which a reader may look up
+            sensor.pub.publish(sensor.message(stamp))
 
     def run_on_ros_time(self):
         """Step whenever physics_step of ROS time has passed; publish at publish_rate."""
