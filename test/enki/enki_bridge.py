@@ -43,6 +43,11 @@ Private parameters (defaults in brackets):
   ~seed          Enki's random seed (motor noise; with >= 0 also the relative sensors'
                  noise); < 0 = Enki's own [-1]
   ~relative_sensors  list of {observer, target, x (m) [0], y (m) [0], noise (m) [0]} [[]]
+  ~wait_for_subscribers  topics (resolved in the node's namespace) that must each have a
+                 subscriber (connected, for the bridge's own topics; at the master, for others)
+                 before cmd_vel is subscribed and anything published: a recorder's, so that it
+                 sees the run from its start [[]]
+  ~wait_timeout  wall s of that wait at most; then the bridge starts anyway [10]
 """
 
 import math
@@ -51,6 +56,7 @@ import threading
 import time
 
 import pyenki
+import rosgraph
 import rospy
 import tf2_ros
 from geometry_msgs.msg import PointStamped, Quaternion, TransformStamped, Twist
@@ -108,6 +114,10 @@ class SimRobot:
         self.cmd_time = None  # rospy.Time of the last command
         self.odom_pub = rospy.Publisher(self.name + "/odom", Odometry, queue_size=10)
         self.truth_pub = rospy.Publisher(self.name + "/ground_truth", Odometry, queue_size=10)
+        self.cmd_sub = None  # listen(): once the bridge is ready
+
+    def listen(self):
+        """Subscribes cmd_vel (a driver waiting for a subscriber starts then)."""
         self.cmd_sub = rospy.Subscriber(self.name + "/cmd_vel", Twist, self.on_cmd, queue_size=1)
 
     def odom_in_world(self, world_frame, odom_global):
@@ -276,6 +286,32 @@ class EnkiBridge:
                       ", ".join("%s (%s)" % (r.name, type(r.robot).__name__) for r in self.robots),
                       self.dt, self.publish_rate,
                       "publishing /clock (rtf %g)" % self.rtf if self.publish_clock else "on ROS time")
+        self.wait_for_subscribers(rospy.get_param("~wait_for_subscribers", []),
+                                  float(rospy.get_param("~wait_timeout", 10.0)))
+        for robot in self.robots:
+            robot.listen()
+
+    def wait_for_subscribers(self, topics, timeout):
+        """Waits (wall time, at most timeout s) until each topic has a subscriber: connected to
+        this bridge's publisher for its own topics (messages sent before are lost to it), known
+        to the master for the others."""
+        topics = [rospy.resolve_name(str(topic)) for topic in topics]
+        own = {pub.resolved_name: pub for robot in self.robots
+               for pub in (robot.odom_pub, robot.truth_pub)}
+        own.update({sensor.pub.resolved_name: sensor.pub for sensor in self.sensors})
+        master = rosgraph.Master(rospy.get_name())
+        end = time.monotonic() + timeout
+        while topics and not rospy.is_shutdown():
+            subscribed = {topic for topic, _ in master.getSystemState()[1]}
+            missing = [topic for topic in topics if (own[topic].get_num_connections() == 0
+                                                     if topic in own else topic not in subscribed)]
+            if not missing:
+                return
+            if time.monotonic() >= end:
+                rospy.logwarn("enki_bridge: no subscriber to %s after %g s: starting anyway",
+                              ", ".join(missing), timeout)
+                return
+            time.sleep(0.05)
 
     def now(self):
         """Current time: the bridge's own clock with ~publish_clock, else ROS time."""
