@@ -59,9 +59,11 @@ import pyenki
 import rosgraph
 import rospy
 import tf2_ros
-from geometry_msgs.msg import PointStamped, Quaternion, TransformStamped, Twist
+from geometry_msgs.msg import Quaternion, TransformStamped, Twist
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
+
+from relative_sensor import RelativeSensor  # beside this script
 
 # Model facts, hard-coded in libenki's C++ constructors and not readable from Python; measured
 # with pyenki 1.6.99: (class, distance between the wheels in cm, maximum wheel speed in cm/s).
@@ -191,55 +193,6 @@ class SimRobot:
         tf.transform.translation.x, tf.transform.translation.y = ox, oy
         tf.transform.rotation = odom.pose.pose.orientation
         return odom, truth, tf
-
-
-class RelativeSensor:
-    """The target's centre seen from a sensor mounted on the observer (PointStamped)."""
-
-    def __init__(self, spec, robots, rng):
-        names = {robot.name: robot for robot in robots}
-        observer = str(spec["observer"]).strip("/")
-        target = str(spec["target"]).strip("/")
-        if observer not in names or target not in names or observer == target:
-            raise ValueError("relative sensor %r: observer and target must be two of the robots %s"
-                             % (spec, sorted(names)))
-        self.observer, self.target = names[observer], names[target]
-        self.mount = (float(spec.get("x", 0.0)), float(spec.get("y", 0.0)))
-        self.noise = float(spec.get("noise", 0.0))
-        if not all(math.isfinite(v) for v in self.mount) or not self.noise >= 0.0:
-            raise ValueError("relative sensor %r: x, y must be finite and noise >= 0" % (spec,))
-        self.rng = rng
-        mounted = self.mount != (0.0, 0.0)
-        self.frame = ("/%s/sensor_%s" % (observer, target)) if mounted else self.observer.base_frame
-        self.pub = rospy.Publisher("%s/relative/%s" % (observer, target), PointStamped, queue_size=10)
-
-    def mount_transform(self):
-        """The static transform observer base_link -> sensor frame, or None at the centre."""
-        if self.frame == self.observer.base_frame:
-            return None
-        t = TransformStamped()
-        t.header.stamp = rospy.Time.now()
-        t.header.frame_id = self.observer.base_frame
-        t.child_frame_id = self.frame
-        t.transform.translation.x, t.transform.translation.y = self.mount
-        t.transform.rotation.w = 1.0
-        return t
-
-    def message(self, stamp):
-        """The target's centre in the sensor's frame (m), stamped ``stamp``."""
-        x, y, yaw = self.observer.state()[:3]
-        tx, ty = self.target.state()[:2]
-        c, s = math.cos(yaw), math.sin(yaw)
-        dx, dy = tx - x, ty - y
-        msg = PointStamped()
-        msg.header.stamp = stamp
-        msg.header.frame_id = self.frame
-        msg.point.x = c * dx + s * dy - self.mount[0]
-        msg.point.y = -s * dx + c * dy - self.mount[1]
-        if self.noise > 0.0:
-            msg.point.x += self.rng.gauss(0.0, self.noise)
-            msg.point.y += self.rng.gauss(0.0, self.noise)
-        return msg
 
 
 class EnkiBridge:
