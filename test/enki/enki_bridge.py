@@ -18,6 +18,15 @@ Per robot ``<name>`` (topics relative to the node's namespace):
   * publishes ``<name>/ground_truth`` (nav_msgs/Odometry): world pose, frame_id ``world``,
     child_frame_id ``/<name>/base_link``, twist in the WORLD frame.
 
+Per relative sensor ``{observer, target}`` of ``~relative_sensors`` (a range-and-bearing or
+camera-like sensor on the observer that sees the target's centre):
+  * publishes ``<observer>/relative/<target>`` (geometry_msgs/PointStamped): the target's centre
+    relative to the sensor, in the sensor's frame, at the publish rate with the same fresh stamps;
+    the sensor sits at the observer's centre (frame ``/<observer>/base_link``) or, with a mount
+    offset x, y (m, in the observer's body frame), in frame ``/<observer>/sensor_<target>``, with a
+    static tf ``/<observer>/base_link`` -> it; ``noise`` (m) adds Gaussian noise of that standard
+    deviation to each coordinate.
+
 Private parameters (defaults in brackets):
   ~robots        list of {name, type: thymio2|epuck, x, y (m), heading (rad)}
                  [robot_0 at (0, 0, 0) and robot_1 at (-0.5, 0, 0), both thymio2]
@@ -31,19 +40,30 @@ Private parameters (defaults in brackets):
   ~publish_clock bool, drive /clock in bursts of physics_step [false]
   ~real_time_factor  sim s per wall s with publish_clock; <= 0 = as fast as possible [1]
   ~arena_radius  m, circular walls centred on the origin; 0 = unbounded world [0]
-  ~seed          Enki's random seed (motor noise); < 0 = Enki's own [-1]
+  ~seed          Enki's random seed (motor noise; with >= 0 also the relative sensors'
+                 noise); < 0 = Enki's own [-1]
+  ~relative_sensors  list of {observer, target, x (m) [0], y (m) [0], noise (m) [0]} [[]]
+  ~wait_for_subscribers  topics (resolved in the node's namespace) that must each have a
+                 subscriber (connected, for the bridge's own topics; at the master, for others)
+                 before cmd_vel is subscribed and anything published: a recorder's, so that it
+                 sees the run from its start [[]]
+  ~wait_timeout  wall s of that wait at most; then the bridge starts anyway [10]
 """
 
 import math
+import random
 import threading
 import time
 
 import pyenki
+import rosgraph
 import rospy
 import tf2_ros
 from geometry_msgs.msg import Quaternion, TransformStamped, Twist
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
+
+from relative_sensor import RelativeSensor  # beside this script
 
 # Model facts, hard-coded in libenki's C++ constructors and not readable from Python; measured
 # with pyenki 1.6.99: (class, distance between the wheels in cm, maximum wheel speed in cm/s).
@@ -96,6 +116,10 @@ class SimRobot:
         self.cmd_time = None  # rospy.Time of the last command
         self.odom_pub = rospy.Publisher(self.name + "/odom", Odometry, queue_size=10)
         self.truth_pub = rospy.Publisher(self.name + "/ground_truth", Odometry, queue_size=10)
+        self.cmd_sub = None  # listen(): once the bridge is ready
+
+    def listen(self):
+        """Subscribes cmd_vel (a driver waiting for a subscriber starts then)."""
         self.cmd_sub = rospy.Subscriber(self.name + "/cmd_vel", Twist, self.on_cmd, queue_size=1)
 
     def odom_in_world(self, world_frame, odom_global):
@@ -196,17 +220,51 @@ class EnkiBridge:
         names = [r.name for r in self.robots]
         if len(set(names)) != len(names):
             raise ValueError("robot names must be unique: %s" % names)
+        rng = random.Random(seed) if seed >= 0 else random.Random()
+        self.sensors = [RelativeSensor(spec, self.robots, rng)
+                        for spec in rospy.get_param("~relative_sensors", [])]
+        frames = [sensor.frame for sensor in self.sensors]
+        if len(set(frames)) != len(frames):
+            raise ValueError("two relative sensors of one observer look at one target")
         self.tf_broadcaster = tf2_ros.TransformBroadcaster()
         world_frame = str(rospy.get_param("~world_frame", ""))
+        static = [robot.odom_in_world(world_frame, self.odom_global)
+                  for robot in self.robots] if world_frame else []
+        static += [t for t in (sensor.mount_transform() for sensor in self.sensors) if t is not None]
         self.static_broadcaster = None
-        if world_frame:
+        if static:  # one latched message holds them all: a second call would replace the first
             self.static_broadcaster = tf2_ros.StaticTransformBroadcaster()
-            self.static_broadcaster.sendTransform(
-                [robot.odom_in_world(world_frame, self.odom_global) for robot in self.robots])
+            self.static_broadcaster.sendTransform(static)
         rospy.loginfo("enki_bridge: %s, physics_step %.3f s, publish_rate %.1f Hz, %s",
                       ", ".join("%s (%s)" % (r.name, type(r.robot).__name__) for r in self.robots),
                       self.dt, self.publish_rate,
                       "publishing /clock (rtf %g)" % self.rtf if self.publish_clock else "on ROS time")
+        self.wait_for_subscribers(rospy.get_param("~wait_for_subscribers", []),
+                                  float(rospy.get_param("~wait_timeout", 10.0)))
+        for robot in self.robots:
+            robot.listen()
+
+    def wait_for_subscribers(self, topics, timeout):
+        """Waits (wall time, at most timeout s) until each topic has a subscriber: connected to
+        this bridge's publisher for its own topics (messages sent before are lost to it), known
+        to the master for the others."""
+        topics = [rospy.resolve_name(str(topic)) for topic in topics]
+        own = {pub.resolved_name: pub for robot in self.robots
+               for pub in (robot.odom_pub, robot.truth_pub)}
+        own.update({sensor.pub.resolved_name: sensor.pub for sensor in self.sensors})
+        master = rosgraph.Master(rospy.get_name())
+        end = time.monotonic() + timeout
+        while topics and not rospy.is_shutdown():
+            subscribed = {topic for topic, _ in master.getSystemState()[1]}
+            missing = [topic for topic in topics if (own[topic].get_num_connections() == 0
+                                                     if topic in own else topic not in subscribed)]
+            if not missing:
+                return
+            if time.monotonic() >= end:
+                rospy.logwarn("enki_bridge: no subscriber to %s after %g s: starting anyway",
+                              ", ".join(missing), timeout)
+                return
+            time.sleep(0.05)
 
     def now(self):
         """Current time: the bridge's own clock with ~publish_clock, else ROS time."""
@@ -225,6 +283,8 @@ class EnkiBridge:
             robot.truth_pub.publish(truth)
             transforms.append(tf)
         self.tf_broadcaster.sendTransform(transforms)
+        for sensor in self.sensors:  # after the tf of the same stamp, which a reader may look up
+            sensor.pub.publish(sensor.message(stamp))
 
     def run_on_ros_time(self):
         """Step whenever physics_step of ROS time has passed; publish at publish_rate."""

@@ -1,14 +1,16 @@
 #!/usr/bin/python3
-"""rostest: the package's nodes driving a pair of Enki robots (test/rostest/enki_pair.test).
+"""rostest: the package's nodes driving Enki robots (test/rostest/enki_pair.test, enki_v.test).
 
-Within ~wall_deadline s the follower must publish ~min_statuses statuses in MODE_TRACKING, on
-the bridge's odometry whose frames carry a leading slash (at 100 Hz, past the leader's push); over
-that run: the adapter's
-cmd_vel reaches robot_1 and it moves (its ground truth at least ~min_travel m from its start), and
-the robots' centres (ground truth) never come closer than ~min_centre_distance m (two Thymios
+Within ~wall_deadline s each follower of ~followers (namespaces; default the pair's `follower`)
+must publish ~min_statuses statuses in MODE_TRACKING, on the bridge's odometry, tf or relative
+sensor whose frames carry a leading slash (at 100 Hz, past the leader's push); over that run: each
+robot of ~followed_robots (default robot_1) moves (its ground truth at least ~min_travel m from
+its start: the adapter's cmd_vel reaches it), and no two robots of ~robots (default robot_0,
+robot_1) come closer than ~min_centre_distance m centre to centre (ground truth; two Thymios
 touch at about 0.11 m).
 """
 
+import itertools
 import math
 import sys
 import threading
@@ -25,32 +27,37 @@ from projection_collision_avoidance.msg import FollowerStatus
 class EnkiPair(unittest.TestCase):
     def setUp(self):
         self.lock = threading.Lock()
-        self.tracking = 0
+        self.followers = list(rospy.get_param("~followers", ["follower"]))
+        self.robots = list(rospy.get_param("~robots", ["robot_0", "robot_1"]))
+        self.moving = list(rospy.get_param("~followed_robots", ["robot_1"]))
+        self.tracking = {name: 0 for name in self.followers}
         self.truth = {}
         self.start = {}
-        self.min_distance = math.inf
-        self.travel = 0.0
-        rospy.Subscriber("/follower/status", FollowerStatus, self.on_status, queue_size=100)
-        for robot in ("robot_0", "robot_1"):
+        self.min_distance = {pair: math.inf for pair in itertools.combinations(self.robots, 2)}
+        self.travel = {robot: 0.0 for robot in self.robots}
+        for name in self.followers:
+            rospy.Subscriber(f"/{name}/status", FollowerStatus, self.on_status, name,
+                             queue_size=100)
+        for robot in self.robots:
             rospy.Subscriber(f"/{robot}/ground_truth", Odometry, self.on_truth, robot,
                              queue_size=100)
 
-    def on_status(self, status):
+    def on_status(self, status, name):
         with self.lock:
             if status.mode == FollowerStatus.MODE_TRACKING:
-                self.tracking += 1
+                self.tracking[name] += 1
 
     def on_truth(self, msg, robot):
         p = msg.pose.pose.position
         with self.lock:
             self.truth[robot] = (p.x, p.y)
-            self.start.setdefault(robot, (p.x, p.y))
-            if len(self.truth) == 2:
-                (x0, y0), (x1, y1) = self.truth["robot_0"], self.truth["robot_1"]
-                self.min_distance = min(self.min_distance, math.hypot(x0 - x1, y0 - y1))
-            if robot == "robot_1":
-                sx, sy = self.start[robot]
-                self.travel = max(self.travel, math.hypot(p.x - sx, p.y - sy))
+            sx, sy = self.start.setdefault(robot, (p.x, p.y))
+            self.travel[robot] = max(self.travel[robot], math.hypot(p.x - sx, p.y - sy))
+            for pair in self.min_distance:
+                if robot in pair and all(r in self.truth for r in pair):
+                    (x0, y0), (x1, y1) = self.truth[pair[0]], self.truth[pair[1]]
+                    self.min_distance[pair] = min(self.min_distance[pair],
+                                                  math.hypot(x0 - x1, y0 - y1))
 
     def wait_for(self, condition, deadline, what):
         end = time.monotonic() + deadline
@@ -59,23 +66,28 @@ class EnkiPair(unittest.TestCase):
                 if condition():
                     return
             time.sleep(0.05)
-        self.fail(what)
+        with self.lock:
+            self.fail(f"{what} (tracking statuses {self.tracking})")
 
     def test_follower_tracks_and_keeps_the_robots_apart(self):
         deadline = float(rospy.get_param("~wall_deadline", 60.0))
         min_statuses = int(rospy.get_param("~min_statuses", 2000))
         min_centre = float(rospy.get_param("~min_centre_distance", 0.12))
         min_travel = float(rospy.get_param("~min_travel", 0.1))
-        self.wait_for(lambda: self.tracking >= 10, deadline,
-                      "the follower never tracks: does it refuse the bridge's odometry?")
-        self.wait_for(lambda: self.tracking >= min_statuses, deadline,
-                      f"fewer than {min_statuses} tracking statuses")
+        end = time.monotonic() + deadline
+        self.wait_for(lambda: min(self.tracking.values()) >= 10, end - time.monotonic(),
+                      "a follower never tracks: does it refuse the bridge's measurements?")
+        self.wait_for(lambda: min(self.tracking.values()) >= min_statuses, end - time.monotonic(),
+                      f"a follower has fewer than {min_statuses} tracking statuses")
         with self.lock:
-            tracking, travel, distance = self.tracking, self.travel, self.min_distance
-        print("enki pair: %d tracking statuses, robot_1 travelled %.3f m, closest "
-              "centres %.3f m" % (tracking, travel, distance), flush=True)
-        self.assertGreater(travel, min_travel, "robot_1 did not move: no cmd_vel reached it")
-        self.assertGreater(distance, min_centre, "the robots came too close")
+            tracking, travel, distance = dict(self.tracking), dict(self.travel), dict(self.min_distance)
+        print("enki: tracking statuses %s, travelled %s m, closest centres %s m" % (
+            tracking, {r: round(travel[r], 3) for r in self.moving},
+            {"-".join(p): round(d, 3) for p, d in distance.items()}), flush=True)
+        for robot in self.moving:
+            self.assertGreater(travel[robot], min_travel, f"{robot} did not move: no cmd_vel reached it")
+        for pair, d in distance.items():
+            self.assertGreater(d, min_centre, "%s and %s came too close" % pair)
 
 
 if __name__ == "__main__":
