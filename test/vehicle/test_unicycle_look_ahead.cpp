@@ -1,7 +1,8 @@
 /// UnicycleLookAhead: the look-ahead velocity against a finite difference of the look-ahead
 /// position on closed-form paths, the inverse map recovering (v, ω), the limits (clipped by a
 /// common factor, the direction of ṗ_l kept, flags), refused inputs, and what a perimeter kept by
-/// the look-ahead points guarantees for the axles.
+/// the look-ahead points guarantees for the axles; a limited, lagging unicycle in closed loop from
+/// any starting heading on a reference that moves behind it.
 
 #include <algorithm>
 #include <cmath>
@@ -12,6 +13,8 @@
 #include <gtest/gtest.h>
 
 #include "projection_collision_avoidance/core/ParameterError.hpp"
+#include "projection_collision_avoidance/sim/VehicleModels.hpp"
+#include "projection_collision_avoidance/vehicle/RelativeVelocityFilter.hpp"
 #include "projection_collision_avoidance/vehicle/UnicycleLookAhead.hpp"
 
 #include "EigenTestHelpers.hpp"
@@ -236,6 +239,78 @@ TEST(UnicycleLookAhead, PerimeterOfLookAheadPointsBoundsTheAxles) {
   const UnicyclePose c{0.0, 0.0, 0.0};
   const UnicyclePose d{2.0, 0.0, kPi};
   EXPECT_NEAR((own.point(c) - other.point(d)).norm(), 1.2, 1e-15);
+}
+
+/// What a closed loop of a limited unicycle driven through command() did.
+struct ClosedLoopRun {
+  double max_error = 0.0;         ///< max ‖p_l − r‖ (m)
+  double final_error = 0.0;       ///< ‖p_l − r‖ at the end (m)
+  int limited_yaw_reversals = 0;  ///< sign changes of ω between two ticks at the yaw-rate limit
+};
+
+/// A unicycle (l = 0.4 m, 4 m/s, 3 rad/s, lag τ = 0.1 s) starting at heading @p theta0 whose
+/// look-ahead point tracks r(t) = r0 + ṙ t, ṙ = 2 m/s along −x (behind the robot for θ0 = 0,
+/// faster than l ω_max = 1.2 m/s), with the double integrator's law a = −k_p (p_l − r)
+/// − k_d (ṗ_l − ṙ), k_p = k_d = 4, and the velocity command ṗ_l + a h (h = T / (1 − e^(−T/τ)),
+/// the velocity integrator's lead) at T = 10 ms, for 20 s. With @p finite_difference, ṗ_l is
+/// estimated from the look-ahead positions (RelativeVelocityFilter, ω = 20 rad/s), as the
+/// follower's `tf` input does; else it is the exact look-ahead velocity (odometry).
+ClosedLoopRun runClosedLoop(double theta0, bool finite_difference) {
+  const double T = 0.01;
+  const double tau = 0.1;
+  const double lead = T / (1.0 - std::exp(-T / tau));
+  const UnicycleLookAhead map(0.4, UnicycleLimits{4.0, 3.0});
+  UnicycleParameters parameters;
+  parameters.velocity_lag = tau;
+  parameters.max_speed = 4.0;
+  parameters.max_yaw_rate = 3.0;
+  UnicycleVehicle robot(UnicycleState{0.0, 0.0, theta0, 0.0, 0.0}, parameters);
+  VelocityFilterOptions filter_options;
+  filter_options.bandwidth = 20.0;
+  RelativeVelocityFilter filter(filter_options);
+  Eigen::VectorXd estimate(4);
+  const Eigen::Vector2d r0 = map.point(UnicyclePose{0.0, 0.0, 0.0});
+  const Eigen::Vector2d reference_velocity(-2.0, 0.0);
+  ClosedLoopRun run;
+  double last_limited_omega = 0.0;
+  for (int k = 0; k <= 2000; ++k) {
+    const double t = k * T;
+    const UnicycleState& s = robot.state();
+    const Eigen::Vector2d p = map.point(UnicyclePose{s.x, s.y, s.theta});
+    Eigen::Vector2d v = map.velocity(s.theta, UnicycleVelocity{s.v, s.omega});
+    if (finite_difference) {
+      const bool estimated = filter.update(t, Eigen::Vector3d(p.x(), p.y(), 0.0), &estimate) ==
+                             VelocityFilterVerdict::kEstimated;
+      v = estimated ? Eigen::Vector2d(estimate.segment<2>(2)) : Eigen::Vector2d::Zero();
+    }
+    const Eigen::Vector2d r = r0 + reference_velocity * t;
+    run.final_error = (p - r).norm();
+    run.max_error = std::max(run.max_error, run.final_error);
+    const Eigen::Vector2d a = -4.0 * (p - r) - 4.0 * (v - reference_velocity);
+    const UnicycleCommand c = map.command(s.theta, v + a * lead);
+    if (c.yaw_rate_limited) {
+      run.limited_yaw_reversals += c.velocity.omega * last_limited_omega < 0.0 ? 1 : 0;
+      last_limited_omega = c.velocity.omega;
+    }
+    robot.setCommand(c.velocity.v, c.velocity.omega);
+    robot.advance(T);
+  }
+  return run;
+}
+
+TEST(UnicycleLookAhead, ClosedLoopFromAnyHeadingOnABackwardReferenceStaysBounded) {
+  // Observed: max error 0.36–1.12 m (largest at 10° off, where the robot turns round), no
+  // reversal of ω at the limit, the error gone by 20 s, on either velocity.
+  for (const bool finite_difference : {false, true}) {
+    for (const double degrees : {0.0, 10.0, 90.0, 170.0, 180.0, -10.0, -90.0}) {
+      SCOPED_TRACE(std::to_string(degrees) + "° off, finite difference " +
+                   std::to_string(finite_difference));
+      const ClosedLoopRun run = runClosedLoop(degrees * kPi / 180.0, finite_difference);
+      EXPECT_LT(run.max_error, 1.5);
+      EXPECT_LT(run.final_error, 0.01);
+      EXPECT_EQ(run.limited_yaw_reversals, 0);
+    }
+  }
 }
 
 }  // namespace
