@@ -54,10 +54,12 @@ set(PCA_SCENARIO_SOURCES
 # state, the unicycle's look-ahead point, velocity commands, the output timeout); Eigen and std.
 set(PCA_VEHICLE_SOURCES
   src/vehicle/CommandConverter.cpp
+  src/vehicle/CommandHistory.cpp
   src/vehicle/OutputWatchdog.cpp
   src/vehicle/RelativeStateFromOdometry.cpp
   src/vehicle/RelativeVelocityFilter.cpp
   src/vehicle/Rotation.cpp
   src/vehicle/UnicycleLookAhead.cpp
+  src/vehicle/VehicleResponseEstimator.cpp
   src/vehicle/VelocityCommandIntegrator.cpp
 )
