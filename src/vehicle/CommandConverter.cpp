@@ -9,9 +9,14 @@
 namespace projection_collision_avoidance {
 namespace {
 
+/// The integrator's options (the period checked first: the integrator is built before the body).
 VelocityIntegratorOptions integratorOptions(const CommandConverterOptions& options) {
+  if (!(options.period > 0.0) || !std::isfinite(options.period)) {
+    throw ParameterError("vehicle.command.period", "must be finite and > 0");
+  }
   VelocityIntegratorOptions velocity = options.velocity;
   velocity.axes = options.unicycle ? 2 : options.axes;
+  velocity.period = options.period;
   return velocity;
 }
 
@@ -35,9 +40,6 @@ CommandConverter::CommandConverter(const CommandConverterOptions& options)
   if (options.unicycle && options.axes != 2) {
     throw ParameterError("vehicle.command.unicycle", "needs a planar (2-axis) model");
   }
-  if (!(options.period > 0.0) || !std::isfinite(options.period)) {
-    throw ParameterError("vehicle.command.period", "must be finite and > 0");
-  }
   if (!(options.max_odometry_age >= 0.0) || !std::isfinite(options.max_odometry_age)) {
     throw ParameterError("vehicle.command.max_odometry_age", "must be finite and >= 0");
   }
@@ -52,6 +54,16 @@ bool CommandConverter::observe(const OdometrySample& own) {
       !sample.linear_velocity.allFinite() || !sample.angular_velocity.allFinite() ||
       normaliseQuaternion(sample.orientation, 1e-2) != QuaternionStatus::kUnit) {
     return false;
+  }
+  // A vehicle whose state changes less often than it is published repeats the same state
+  // with a new stamp: its state was taken when it first appeared.
+  const bool same_state = have_own_ && sample.position == own_.position &&
+                          sample.orientation.coeffs() == own_.orientation.coeffs() &&
+                          sample.linear_velocity == own_.linear_velocity &&
+                          sample.angular_velocity == own_.angular_velocity &&
+                          sample.stamp >= own_changed_at_;
+  if (!same_state) {
+    own_changed_at_ = sample.stamp;
   }
   own_ = sample;
   have_own_ = true;
@@ -75,7 +87,7 @@ const ConvertedCommand& CommandConverter::convert(
   const bool have_heading = fresh(now);
   const int axes = integrator_.options().axes;
   if (have_heading) {
-    integrator_.measure(controlledPointVelocity().head(axes), own_.stamp);
+    integrator_.measure(controlledPointVelocity().head(axes), own_.stamp, own_changed_at_);
   }
   const VelocityCommand& command =
       integrator_.step(out_.acceleration.head(axes), options_.period, now);

@@ -49,9 +49,9 @@ void CommandHistory::replaceNewest(const AxisVector& velocity) {
   newest.velocity = velocity;
 }
 
-bool CommandHistory::commandAt(double time, AxisVector* velocity) const {
+bool CommandHistory::commandBefore(double time, AxisVector* velocity) const {
   for (std::size_t i = size_; i-- > 0;) {
-    if (at(i).time <= time) {
+    if (at(i).time < time) {
       *velocity = at(i).velocity;
       return true;
     }
@@ -59,14 +59,14 @@ bool CommandHistory::commandAt(double time, AxisVector* velocity) const {
   return false;
 }
 
-AxisVector CommandHistory::incrementBetween(double after, double until) const {
+AxisVector CommandHistory::incrementBetween(double from, double before) const {
   AxisVector sum = AxisVector::Zero(axes_);
   for (std::size_t i = size_; i-- > 0;) {
     const SentCommand& command = at(i);
-    if (command.time <= after) {
+    if (command.time < from) {
       break;  // times are non-decreasing: every older one is earlier still
     }
-    if (command.time <= until) {
+    if (command.time < before) {
       sum += command.increment;
     }
   }

@@ -69,7 +69,7 @@ void VehicleResponseEstimator::observe(const AxisVector& velocity, double change
   std::size_t index = 0;
   for (int j = 0; j < candidates_; ++j) {
     const double at = changed_at - j * options_.period;
-    while (index < history.size() && history.fromNewest(index).time > at) {
+    while (index < history.size() && history.fromNewest(index).time >= at) {
       ++index;
     }
     if (index == history.size()) {

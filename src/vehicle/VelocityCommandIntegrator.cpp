@@ -1,6 +1,8 @@
 #include "projection_collision_avoidance/vehicle/VelocityCommandIntegrator.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "projection_collision_avoidance/core/BallConstraint.hpp"
@@ -16,12 +18,35 @@ double velocityLead(double period, double velocity_lag) {
   return period / -std::expm1(-period / velocity_lag);
 }
 
-VelocityCommandIntegrator::VelocityCommandIntegrator(const VelocityIntegratorOptions& options)
-    : options_(options) {
-  if (options.axes < 1 || options.axes > 3) {
-    throw ParameterError("vehicle.velocity.axes",
-                         "must be 1, 2 or 3, got " + std::to_string(options.axes));
+namespace {
+
+ResponseEstimatorOptions estimatorOptions(const VelocityIntegratorOptions& options) {
+  ResponseEstimatorOptions estimator;
+  estimator.period = options.period;
+  estimator.max_delay = options.max_delay;
+  estimator.averaging_time = options.averaging_time;
+  return estimator;
+}
+
+/// Commands kept: a delay and a hold, each up to max_delay (validated by the estimator first).
+std::size_t historyCapacity(const VelocityIntegratorOptions& options) {
+  const VehicleResponseEstimator check(estimatorOptions(options));
+  return 2 * static_cast<std::size_t>(check.candidates()) + 2;
+}
+
+int checkedAxes(int axes) {
+  if (axes < 1 || axes > 3) {
+    throw ParameterError("vehicle.velocity.axes", "must be 1, 2 or 3, got " + std::to_string(axes));
   }
+  return axes;
+}
+
+}  // namespace
+
+VelocityCommandIntegrator::VelocityCommandIntegrator(const VelocityIntegratorOptions& options)
+    : options_(options),
+      history_(historyCapacity(options), checkedAxes(options.axes)),
+      estimator_(estimatorOptions(options)) {
   if (!(options.max_speed > 0.0)) {
     throw ParameterError("vehicle.velocity.max_speed", "must be > 0 m/s (or infinity: none), got " +
                                                            std::to_string(options.max_speed));
@@ -35,18 +60,37 @@ VelocityCommandIntegrator::VelocityCommandIntegrator(const VelocityIntegratorOpt
     throw ParameterError("vehicle.velocity.velocity_lag",
                          "must be finite and >= 0 s, got " + std::to_string(options.velocity_lag));
   }
+  if (!(options.delay <= options.max_delay)) {
+    throw ParameterError("vehicle.velocity.delay",
+                         "must be <= max_delay (" + std::to_string(options.max_delay) +
+                             " s), or < 0 to estimate it, got " + std::to_string(options.delay));
+  }
   measured_ = AxisVector::Zero(options.axes);
   command_.velocity = AxisVector::Zero(options.axes);
 }
 
-bool VelocityCommandIntegrator::measure(const AxisVector& velocity, double stamp) {
-  if (velocity.size() != options_.axes || !velocity.allFinite() || !std::isfinite(stamp)) {
+bool VelocityCommandIntegrator::measure(const AxisVector& velocity, double stamp,
+                                        double changed_at) {
+  if (velocity.size() != options_.axes || !velocity.allFinite() || !std::isfinite(stamp) ||
+      !std::isfinite(changed_at)) {
     return false;
+  }
+  changed_at = std::min(changed_at, stamp);
+  if (!have_measurement_ || changed_at != measured_changed_at_) {
+    estimator_.observe(velocity, changed_at, history_);
   }
   measured_ = velocity;
   measured_stamp_ = stamp;
+  measured_changed_at_ = changed_at;
   have_measurement_ = true;
   return true;
+}
+
+double VelocityCommandIntegrator::delay() const {
+  if (options_.velocity_lag > 0.0) {
+    return 0.0;
+  }
+  return options_.delay >= 0.0 ? options_.delay : estimator_.response().delay;
 }
 
 const VelocityCommand& VelocityCommandIntegrator::step(const AxisVector& acceleration,
@@ -54,7 +98,18 @@ const VelocityCommand& VelocityCommandIntegrator::step(const AxisVector& acceler
   // Written so that a NaN now makes the measurement stale.
   const bool fresh =
       have_measurement_ && std::abs(now - measured_stamp_) <= options_.max_measurement_age;
-  AxisVector anchor = fresh ? measured_ : command_.velocity;
+  if (history_.size() > 0 && !(now >= history_.fromNewest(0).time)) {
+    history_.clear();  // time went back: the commands sent "later" are of another timeline
+  }
+  AxisVector anchor = command_.velocity;
+  if (fresh) {  // the measurement and the commands sent since the state it shows
+    anchor = measured_ + history_.incrementBetween(measured_changed_at_ - delay(),
+                                                   std::numeric_limits<double>::infinity());
+  }
+  if (!anchor.allFinite()) {  // increments that overflow: start from the measurement alone
+    anchor = measured_;
+  }
+  const AxisVector base = anchor;
   command_.anchor = fresh ? VelocityAnchor::kMeasured : VelocityAnchor::kPreviousCommand;
   command_.limited = false;
   command_.refused = acceleration.size() != options_.axes || !acceleration.allFinite() ||
@@ -69,6 +124,7 @@ const VelocityCommand& VelocityCommandIntegrator::step(const AxisVector& acceler
     }
   }
   command_.limited = clampNorm(anchor, options_.max_speed) > 0.0;
+  history_.push(now, anchor, anchor - base);
   command_.velocity = anchor;
   return command_;
 }
@@ -76,12 +132,14 @@ const VelocityCommand& VelocityCommandIntegrator::step(const AxisVector& acceler
 void VelocityCommandIntegrator::setSent(const AxisVector& velocity) {
   if (velocity.size() == options_.axes && velocity.allFinite()) {
     command_.velocity = velocity;
+    history_.replaceNewest(velocity);
   }
 }
 
 void VelocityCommandIntegrator::reset() {
   measured_.setZero();
   have_measurement_ = false;
+  history_.clear();
   command_ = VelocityCommand();
   command_.velocity = AxisVector::Zero(options_.axes);
 }

@@ -16,6 +16,7 @@
 #include "projection_collision_avoidance/sim/SampledSimulator.hpp"
 #include "projection_collision_avoidance/sim/ScenarioEmbedding.hpp"
 #include "projection_collision_avoidance/sim/VehicleModels.hpp"
+#include "projection_collision_avoidance/vehicle/CommandConverter.hpp"
 
 #include "AllocationCounter.hpp"
 #include "TestScenarios.hpp"
@@ -223,6 +224,31 @@ TEST(NoAllocation, VehicleModelSteps) {
   EXPECT_EQ(testing::allocationCount() - before, 0);
   EXPECT_TRUE(velocity.position().allFinite());
   EXPECT_TRUE(std::isfinite(unicycle.state().x));
+}
+
+/// The command adapter's conversion (velocity commands brought up to date with the command
+/// history, the response estimate, the unicycle map) takes odometry and commands without the heap.
+TEST(NoAllocation, CommandConversions) {
+  for (const bool unicycle : {false, true}) {
+    CommandConverterOptions options;
+    options.axes = 2;
+    options.unicycle = unicycle;
+    CommandConverter converter(options);
+    OdometrySample own;
+    const Eigen::VectorXd acceleration = Eigen::Vector2d(0.3, -0.2);
+    converter.convert(acceleration, 0.0);  // the first command, before the loop
+    const long before = testing::allocationCount();
+    for (int k = 1; k < 1000; ++k) {
+      own.stamp = 0.01 * k;
+      if (k % 10 == 0) {  // a state that changes every 10 periods, republished in between
+        own.linear_velocity.x() = 0.001 * k;
+      }
+      converter.observe(own);
+      converter.convert(acceleration, own.stamp);
+    }
+    EXPECT_EQ(testing::allocationCount() - before, 0) << unicycle;
+    EXPECT_GT(converter.response().observations, 50U);
+  }
 }
 
 /// The sampled closed loop allocates while it sets up and nothing per tick: a run twice as long

@@ -88,10 +88,12 @@ TEST(CommandConverter, AUnicycleTurnsTowardASidewaysAcceleration) {
   const ConvertedCommand& ahead = converter.convert(accel(1.0, 0.0), 10.0);
   EXPECT_NEAR(ahead.unicycle.velocity.v, kPeriod, 1e-12);
   EXPECT_NEAR(ahead.unicycle.velocity.omega, 0.0, 1e-12);
-  ASSERT_TRUE(converter.observe(own(10.01, 0.0, 0.0)));
+  // The robot did as it was told: 0.01 m/s ahead.
+  ASSERT_TRUE(converter.observe(own(10.01, 0.0, kPeriod)));
   const ConvertedCommand& left = converter.convert(accel(0.0, 1.0), 10.01);
-  // The look-ahead point 0.2 m ahead moves left at 0.01 m/s: omega = 0.01 / 0.2.
-  EXPECT_NEAR(left.unicycle.velocity.v, 0.0, 1e-12);
+  // The look-ahead point 0.2 m ahead keeps on ahead and moves left at 0.01 m/s as well:
+  // omega = 0.01 / 0.2.
+  EXPECT_NEAR(left.unicycle.velocity.v, kPeriod, 1e-12);
   EXPECT_NEAR(left.unicycle.velocity.omega, kPeriod / 0.2, 1e-12);
 }
 
@@ -128,6 +130,25 @@ TEST(CommandConverter, TheStopBrakesAndZeroesTheVelocities) {
   const ConvertedCommand& again = converter.convert(accel(1.0, 0.0), 11.0);
   EXPECT_EQ(again.anchor, VelocityAnchor::kPreviousCommand);
   EXPECT_NEAR(again.velocity.x(), kPeriod, 1e-12);
+}
+
+/// A vehicle whose state changes less often than its odometry is published repeats the same
+/// state with new stamps: the state is dated by the first of them.
+TEST(CommandConverter, ARepeatedStateIsDatedByItsFirstStamp) {
+  CommandConverter converter(options());
+  ASSERT_TRUE(converter.observe(own(1.0, 0.3, 0.5)));
+  EXPECT_EQ(converter.stateChangedAt(), 1.0);
+  ASSERT_TRUE(converter.observe(own(1.05, 0.3, 0.5)));
+  EXPECT_EQ(converter.stateChangedAt(), 1.0);
+  ASSERT_TRUE(converter.observe(own(1.1, 0.3, 0.6)));  // a new velocity
+  EXPECT_EQ(converter.stateChangedAt(), 1.1);
+  OdometrySample moved = own(1.2, 0.3, 0.6);
+  moved.position.x() = 1e-3;
+  ASSERT_TRUE(converter.observe(moved));
+  EXPECT_EQ(converter.stateChangedAt(), 1.2);
+  moved.stamp = 1.15;  // the same state stamped earlier: dated by that stamp
+  ASSERT_TRUE(converter.observe(moved));
+  EXPECT_EQ(converter.stateChangedAt(), 1.15);
 }
 
 TEST(CommandConverter, RefusesUnusableOptionsAndOdometry) {

@@ -2,6 +2,7 @@
 /// interval, the ring dropping its oldest, the newest replaced by what was sent, time going back,
 /// and inputs it ignores.
 
+#include <cmath>
 #include <limits>
 #include <string>
 
@@ -22,19 +23,19 @@ TEST(CommandHistory, RefusesNoCapacityAndBadAxes) {
   EXPECT_NO_THROW(CommandHistory(1, 3));
 }
 
-TEST(CommandHistory, TheCommandInForceIsTheLastSentAtOrBeforeTheTime) {
+TEST(CommandHistory, TheCommandInForceIsTheLastSentBeforeTheTime) {
   CommandHistory history(8, 1);
   AxisVector v = vec(-7.0);
-  EXPECT_FALSE(history.commandAt(1.0, &v));
+  EXPECT_FALSE(history.commandBefore(1.0, &v));
   history.push(1.0, vec(10.0), vec(1.0));
   history.push(2.0, vec(20.0), vec(2.0));
-  EXPECT_FALSE(history.commandAt(0.999, &v));
+  EXPECT_FALSE(history.commandBefore(1.0, &v));  // sent at 1.0: not before it
   EXPECT_EQ(v(0), -7.0);
-  ASSERT_TRUE(history.commandAt(1.0, &v));
+  ASSERT_TRUE(history.commandBefore(std::nextafter(1.0, 2.0), &v));
   EXPECT_EQ(v(0), 10.0);
-  ASSERT_TRUE(history.commandAt(1.999, &v));
+  ASSERT_TRUE(history.commandBefore(2.0, &v));
   EXPECT_EQ(v(0), 10.0);
-  ASSERT_TRUE(history.commandAt(5.0, &v));
+  ASSERT_TRUE(history.commandBefore(5.0, &v));
   EXPECT_EQ(v(0), 20.0);
 }
 
@@ -43,9 +44,10 @@ TEST(CommandHistory, IncrementsAreSummedOverAHalfOpenInterval) {
   for (int k = 1; k <= 5; ++k) {
     history.push(k, vec(k), vec(k));  // increments 1 … 5 at t = 1 … 5
   }
-  EXPECT_EQ(history.incrementBetween(2.0, 4.0)(0), 3.0 + 4.0);
-  EXPECT_EQ(history.incrementBetween(1.5, 5.0)(0), 2.0 + 3.0 + 4.0 + 5.0);
-  EXPECT_EQ(history.incrementBetween(5.0, 9.0)(0), 0.0);
+  EXPECT_EQ(history.incrementBetween(2.0, 4.0)(0), 2.0 + 3.0);
+  EXPECT_EQ(history.incrementBetween(1.5, 5.0)(0), 2.0 + 3.0 + 4.0);
+  EXPECT_EQ(history.incrementBetween(5.0, 9.0)(0), 5.0);
+  EXPECT_EQ(history.incrementBetween(5.5, 9.0)(0), 0.0);
   EXPECT_EQ(history.incrementBetween(-std::numeric_limits<double>::infinity(),
                                      std::numeric_limits<double>::infinity())(0),
             15.0);
@@ -60,7 +62,7 @@ TEST(CommandHistory, AFullRingDropsItsOldest) {
   EXPECT_EQ(history.fromNewest(0).time, 5.0);
   EXPECT_EQ(history.fromNewest(2).time, 3.0);
   AxisVector v = vec(0.0);
-  EXPECT_FALSE(history.commandAt(2.5, &v));
+  EXPECT_FALSE(history.commandBefore(3.0, &v));
   EXPECT_EQ(history.incrementBetween(0.0, 10.0)(0), 3.0 + 4.0 + 5.0);
 }
 

@@ -38,7 +38,7 @@ struct VehicleRun {
       const double t = k * kPeriod;
       if (t >= next_update - 1e-9) {
         AxisVector shown = vec(0.0);
-        history.commandAt(t - delay + 1e-9, &shown);
+        history.commandBefore(t - delay, &shown);
         estimator->observe(gain * shown, t, history);
         next_update += update;
       }

@@ -79,12 +79,16 @@ TEST(VelocityCommandIntegrator, AnchorsOnAFreshMeasurementElseOnThePreviousComma
   EXPECT_MATRIX_NEAR(c.velocity, vec(0.5, -1.0), 0.0);
   c = integrator.step(vec(1.0, -2.0), 0.5, 0.5);
   EXPECT_MATRIX_NEAR(c.velocity, vec(1.0, -2.0), 0.0);
-  // A measurement taken at 1.0 s is fresh until 1.125 s, and from 0.875 s.
+  // A measurement taken at 1.0 s is fresh until 1.125 s, and from 0.875 s. The command sent at
+  // 1.0 s is not in it yet: at 1.125 s it is added to the anchor. At 0.875 s time went back:
+  // the commands sent "later" are forgotten.
   ASSERT_TRUE(integrator.measure(vec(3.0, 4.0), 1.0));
-  for (double now : {1.0, 1.125, 0.875}) {
+  const std::pair<double, AxisVector> steps[] = {
+      {1.0, vec(3.125, 3.75)}, {1.125, vec(3.25, 3.5)}, {0.875, vec(3.125, 3.75)}};
+  for (const auto& [now, expected] : steps) {
     c = integrator.step(vec(0.5, -1.0), 0.25, now);
     EXPECT_EQ(c.anchor, VelocityAnchor::kMeasured) << now;
-    EXPECT_MATRIX_NEAR(c.velocity, vec(3.125, 3.75), 0.0);
+    EXPECT_MATRIX_NEAR(c.velocity, expected, 0.0);
   }
   c = integrator.step(vec(0.5, -1.0), 0.25, std::nextafter(1.125, kInf));
   EXPECT_EQ(c.anchor, VelocityAnchor::kPreviousCommand);
@@ -136,8 +140,13 @@ TEST(VelocityCommandIntegrator, LeadMakesALaggingVehicleGainATPerPeriod) {
   const double T = 0.01;
   const double tau = 0.2;
   const double decay = std::exp(-T / tau);
-  for (double lag : {tau, 0.0}) {
-    VelocityCommandIntegrator integrator(options(1, kInf, 0.05, lag));
+  // τ configured; not configured with D estimated; not configured with D = 0 (the measured
+  // velocity taken as the command in force).
+  for (int variant = 0; variant < 3; ++variant) {
+    const double lag = variant == 0 ? tau : 0.0;
+    VelocityIntegratorOptions o = options(1, kInf, 0.05, lag);
+    o.delay = variant == 2 ? 0.0 : -1.0;
+    VelocityCommandIntegrator integrator(o);
     double v = 0.3;
     double gained = 0.0;
     for (int k = 0; k < 100; ++k) {
@@ -147,9 +156,13 @@ TEST(VelocityCommandIntegrator, LeadMakesALaggingVehicleGainATPerPeriod) {
       gained = next - v;
       v = next;
     }
-    if (lag > 0.0) {
+    if (variant == 0) {
       EXPECT_NEAR(gained, 1.5 * T, 1e-12);  // the acceleration asked for
       EXPECT_NEAR(v, 0.3 + 1.5, 1e-10);
+    } else if (variant == 1) {
+      // The lag read as a delay of about τ: most of it, though not all (a lag is not a delay).
+      EXPECT_GT(gained, 0.6 * 1.5 * T);
+      EXPECT_NEAR(integrator.delay(), tau, 0.1);
     } else {
       EXPECT_LT(gained, 0.05 * 1.5 * T);  // v + a T: only 1 − e^(−T/τ) ≈ 5 % of it
     }
@@ -193,6 +206,104 @@ TEST(VelocityCommandIntegrator, RefusedInputsHoldTheAnchor) {
   const VelocityCommand c = integrator.step(vec(1.0, 0.0), 0.1, 0.0);
   EXPECT_EQ(c.anchor, VelocityAnchor::kPreviousCommand);
   EXPECT_MATRIX_NEAR(c.velocity, vec(0.1, 0.0), 1e-17);
+}
+
+/// A vehicle slower than the controller: its state changes every P = 10 T (a physics step), when
+/// its velocity becomes the command it was sent before the previous change (actuation_steps 1)
+/// or before this one (0); its odometry is republished every T with a fresh stamp. Returns the
+/// velocity gained per second over 2 s of a steady push @p a, divided by a.
+double heldVehicleRealises(VelocityCommandIntegrator& integrator, bool dated, int actuation_steps,
+                           double a) {
+  const double T = 0.01;
+  const int hold = 10;
+  double v = 0.0;
+  double pending = 0.0;  // the command the next physics step applies (actuation_steps 1)
+  double latest = 0.0;   // the latest command sent
+  double changed_at = 0.0;
+  double v_start = 0.0;
+  for (int k = 0; k <= 400; ++k) {
+    const double now = k * T;
+    if (k % hold == 0) {
+      v = actuation_steps == 0 ? latest : pending;
+      pending = latest;
+      changed_at = now;
+    }
+    if (k == 200) {
+      v_start = v;
+    }
+    EXPECT_TRUE(dated ? integrator.measure(vec(v), now, changed_at)
+                      : integrator.measure(vec(v), now));
+    latest = integrator.step(vec(a), T, now).velocity(0);
+  }
+  return (v - v_start) / 2.0 / a;
+}
+
+TEST(VelocityCommandIntegrator, AVehicleSlowerThanTheControllerRealisesTheAcceleration) {
+  for (int actuation_steps : {0, 1}) {
+    VelocityCommandIntegrator integrator(options(1, kInf, 0.25));
+    const double realised = heldVehicleRealises(integrator, true, actuation_steps, 0.5);
+    EXPECT_NEAR(realised, 1.0, 0.1) << actuation_steps;
+    const VehicleResponse& response = integrator.response();
+    EXPECT_NEAR(response.update_interval, 0.1, 1e-9);
+    EXPECT_NEAR(response.realised_fraction, 1.0, 0.1) << actuation_steps;
+    EXPECT_NEAR(integrator.delay(), 0.1 * actuation_steps, 0.011) << actuation_steps;
+    // Each stamp taken as the state's (not dated): the anchor forgets the commands the held
+    // state does not show yet, and most of the acceleration is lost.
+    VelocityIntegratorOptions o = options(1, kInf, 0.25);
+    o.delay = 0.0;
+    VelocityCommandIntegrator undated(o);
+    EXPECT_LT(heldVehicleRealises(undated, false, actuation_steps, 0.5), 0.3) << actuation_steps;
+    // Not dated but with the delay estimated, the hold is read as a delay of up to P (and one
+    // more P of actuation) and made up for as well.
+    VelocityCommandIntegrator estimated(options(1, kInf, 0.25));
+    EXPECT_NEAR(heldVehicleRealises(estimated, false, actuation_steps, 0.5), 1.0, 0.1)
+        << actuation_steps;
+  }
+}
+
+/// The increments added to a held measurement span at most the history (2 max_delay + 2 T):
+/// against a vehicle that cannot exceed 1 m/s the command stays within a h of that bound, and
+/// it comes back below the limit soon after the push reverses.
+TEST(VelocityCommandIntegrator, NoWindUpAgainstASaturatingVehicleSlowerThanTheController) {
+  const double T = 0.01;
+  const double a = 2.0;
+  VelocityIntegratorOptions o = options(1, kInf, 0.25);
+  VelocityCommandIntegrator integrator(o);
+  double v = 0.0;
+  double latest = 0.0;
+  double changed_at = 0.0;
+  double largest = 0.0;
+  int below_after = -1;
+  for (int k = 0; k < 1000; ++k) {
+    const double now = k * T;
+    if (k % 10 == 0) {
+      v = std::min(latest, 1.0);
+      changed_at = now;
+    }
+    ASSERT_TRUE(integrator.measure(vec(v), now, changed_at));
+    latest = integrator.step(vec(k < 500 ? a : -a), T, now).velocity(0);
+    largest = std::max(largest, latest);
+    if (k >= 500 && below_after < 0 && latest < 1.0) {
+      below_after = k - 500;
+    }
+  }
+  EXPECT_LE(largest, 1.0 + a * (2.0 * o.max_delay + 3.0 * T) + 1e-9);
+  ASSERT_GE(below_after, 0);
+  EXPECT_LE(below_after * T, 2.0 * o.max_delay + 3.0 * T);
+}
+
+TEST(VelocityCommandIntegrator, RefusesADelayPastItsLimit) {
+  VelocityIntegratorOptions o = options(1);
+  o.delay = o.max_delay + 0.01;
+  EXPECT_EQ(refusedKey(o), "vehicle.velocity.delay");
+  o.delay = kNaN;
+  EXPECT_EQ(refusedKey(o), "vehicle.velocity.delay");
+  o = options(1);
+  o.period = 0.0;
+  EXPECT_EQ(refusedKey(o), "vehicle.velocity.period");
+  o = options(1);
+  o.max_delay = 300.0 * o.period;
+  EXPECT_EQ(refusedKey(o), "vehicle.velocity.max_delay");
 }
 
 /// The unicycle's acceleration command: a_l integrated into ṗ_l, mapped to (v, ω) under limits,

@@ -59,7 +59,9 @@ class CommandConverter {
   explicit CommandConverter(const CommandConverterOptions& options);
 
   /// Notes the vehicle's own odometry (any frame of origin: only its orientation and velocity are
-  /// used). @return false (nothing noted) if not finite or its quaternion is not unit.
+  /// used). A sample equal in every value to the previous one is the same state published
+  /// again: its state is dated by the first of them (stateChangedAt()).
+  /// @return false (nothing noted) if not finite or its quaternion is not unit.
   bool observe(const OdometrySample& own);
 
   /// The conversion of the follower's acceleration @p acceleration (axes entries, m/s², world
@@ -72,6 +74,13 @@ class CommandConverter {
   const ConvertedCommand& stop(double now);
 
   const CommandConverterOptions& options() const { return options_; }
+  /// How the vehicle follows the velocity commands (VehicleResponseEstimator).
+  const VehicleResponse& response() const { return integrator_.response(); }
+  /// The response delay D (s) the velocity commands are built with.
+  double delay() const { return integrator_.delay(); }
+  /// When the own odometry's state last changed (s): earlier than its stamp for a vehicle whose
+  /// state changes less often than its odometry is published.
+  double stateChangedAt() const { return own_changed_at_; }
 
  private:
   /// Whether the own odometry is fresh at @p now.
@@ -83,6 +92,7 @@ class CommandConverter {
   VelocityCommandIntegrator integrator_;
   UnicycleLookAhead look_ahead_;
   OdometrySample own_;
+  double own_changed_at_ = 0.0;
   bool have_own_ = false;
   ConvertedCommand out_;
 };

@@ -35,13 +35,14 @@ class CommandHistory {
   /// changed by the same amount. Ignored when empty, not finite or of the wrong size.
   void replaceNewest(const AxisVector& velocity);
 
-  /// The command in force at @p time (s): the last one sent at or before it.
-  /// @return false (velocity untouched) when no kept command was sent by then
-  bool commandAt(double time, AxisVector* velocity) const;
+  /// The command in force just before @p time (s): the last one sent before it. (A velocity
+  /// measured at t shows at most the commands sent before t: one sent at t was made after it.)
+  /// @return false (velocity untouched) when no kept command was sent before then
+  bool commandBefore(double time, AxisVector* velocity) const;
 
-  /// Σ of the increments of the kept commands sent in (@p after, @p until] (s): the velocity
+  /// Σ of the increments of the kept commands sent in [@p from, @p before) (s): the velocity
   /// change the commands of that interval asked for.
-  AxisVector incrementBetween(double after, double until) const;
+  AxisVector incrementBetween(double from, double before) const;
 
   /// Forgets every command.
   void clear();

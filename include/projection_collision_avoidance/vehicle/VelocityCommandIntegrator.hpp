@@ -10,11 +10,11 @@
 #include <Eigen/Core>
 
 #include "projection_collision_avoidance/core/TypeDefs.hpp"
+#include "projection_collision_avoidance/vehicle/AxisVector.hpp"
+#include "projection_collision_avoidance/vehicle/CommandHistory.hpp"
+#include "projection_collision_avoidance/vehicle/VehicleResponseEstimator.hpp"
 
 namespace projection_collision_avoidance {
-
-/// A vector of 1 to 3 axes (m/s or m/s²), stored inline.
-using AxisVector = BoundedMatrix<Eigen::Dynamic, 1, 3, 1>;
 
 /// What the velocity command was built on.
 enum class VelocityAnchor {
@@ -32,6 +32,16 @@ struct VelocityIntegratorOptions {
   /// τ (s), ≥ 0: the time constant of the vehicle's velocity loop, v̇ = (v_cmd − v) / τ; 0 for
   /// a vehicle that reaches its command within a period
   double velocity_lag = 0.0;
+  /// T (s), > 0: the control period, the spacing of the candidate delays
+  double period = 0.01;
+  /// D (s): the measured velocity is the command in force D before it was taken; < 0: estimated
+  /// (VehicleResponseEstimator), ≤ max_delay. Not used with a velocity_lag (> 0).
+  double delay = -1.0;
+  /// s, ≥ 0, ≤ 255 T: the longest delay estimated; commands are predicted over at most
+  /// 2 max_delay past a measurement
+  double max_delay = 0.3;
+  /// s, > 0: the memory of the response estimates
+  double averaging_time = 1.0;
 };
 
 /// One velocity command and how it was made.
@@ -50,10 +60,12 @@ struct VelocityCommand {
 double velocityLead(double period, double velocity_lag);
 
 /// v_cmd(k+1) = clamp(v_anchor + a h, max_speed):
-/// - anchor = the measured velocity when fresh, h = velocityLead(T, τ): the command is a fixed
-///   lead a h ahead of what the vehicle does, so when the vehicle's own controller saturates
-///   (it cannot follow) the command stays at v_measured + a h instead of growing: no wind-up, by
-///   construction (there is no integrator state).
+/// - anchor = the measured velocity v_m when fresh, brought up to date with the commands it does
+///   not show yet: v_anchor = v_m + Σ Δc_j over the commands sent after t_m − D (t_m: when the
+///   measured state changed last, D: the response delay), h = velocityLead(T, τ). The command is
+///   a fixed lead ahead of what the vehicle will do, so when the vehicle's own controller
+///   saturates (it cannot follow) the command stays within the increments of the last
+///   2 max_delay of v_measured instead of growing: no wind-up beyond that bound.
 /// - anchor = the previous command when the measurement is not fresh, h = T: a plain integrator,
 ///   whose state is the limited command itself (clamping anti-windup at max_speed).
 /// clamp() scales a vector longer than max_speed onto it, keeping its direction (clampNorm()).
@@ -65,9 +77,13 @@ class VelocityCommandIntegrator {
   ///         .velocity_lag
   explicit VelocityCommandIntegrator(const VelocityIntegratorOptions& options);
 
-  /// Notes the vehicle's measured velocity (m/s, the command's frame) at @p stamp (s).
+  /// Notes the vehicle's measured velocity (m/s, the command's frame) at @p stamp (s), a state
+  /// that changed last at @p changed_at (s, ≤ stamp: a vehicle whose state changes less often
+  /// than it is published); a new changed_at is a change of state for the response estimate.
   /// @return false (and nothing noted) if not finite or not of the options' axes
-  bool measure(const AxisVector& velocity, double stamp);
+  bool measure(const AxisVector& velocity, double stamp, double changed_at);
+  /// measure() of a state taken at @p stamp.
+  bool measure(const AxisVector& velocity, double stamp) { return measure(velocity, stamp, stamp); }
 
   /// The command for the follower's acceleration @p acceleration (m/s²) over the period
   /// @p period (s) at time @p now (s); it becomes the previous command.
@@ -78,16 +94,24 @@ class VelocityCommandIntegrator {
   /// not finite or of the wrong size.
   void setSent(const AxisVector& velocity);
 
-  /// Back to rest: previous command zero, no measurement.
+  /// Back to rest: previous command zero, no measurement, no history (the response estimate
+  /// is kept: it describes the vehicle).
   void reset();
 
   const VelocityCommand& last() const { return command_; }
   const VelocityIntegratorOptions& options() const { return options_; }
+  /// The vehicle's response as estimated so far.
+  const VehicleResponse& response() const { return estimator_.response(); }
+  /// The response delay D (s) the anchor uses.
+  double delay() const;
 
  private:
   VelocityIntegratorOptions options_;
+  CommandHistory history_;
+  VehicleResponseEstimator estimator_;
   AxisVector measured_;
   double measured_stamp_ = 0.0;
+  double measured_changed_at_ = 0.0;
   bool have_measurement_ = false;
   VelocityCommand command_;
 };
