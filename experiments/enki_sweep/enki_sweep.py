@@ -52,8 +52,8 @@ QUICK = [
 ]
 FIELDS = ["vehicle", "input", "physics_step", "heading_deg", "push_scale", "statuses", "tracking",
           "fallback_steps", "rejected", "max_xi", "xi_max", "min_controlled", "min_centres",
-          "perimeter", "accel_ratio", "accel_windows", "limited_fraction", "recorded_from",
-          "wall_s", "result"]
+          "perimeter", "accel_ratio", "accel_windows", "limited_fraction", "adapter_update",
+          "adapter_delay", "adapter_realised", "recorded_from", "wall_s", "result"]
 MAX_SPEED = {"thymio2": 0.166, "epuck": 0.128}
 MAX_YAW_RATE = {"thymio2": 3.5, "epuck": 5.0}
 
@@ -63,9 +63,10 @@ def yaw_of(q):
 
 
 def read_bag(path):
-    """Ground truth per robot {stamp ns: (x, y, yaw, vx, vy, wz)}, statuses, commands, cmd_vel."""
+    """Ground truth per robot {stamp ns: (x, y, yaw, vx, vy, wz)}, statuses, commands, cmd_vel
+    and the command adapter's last diagnostics values."""
     truth = {"robot_0": {}, "robot_1": {}}
-    statuses, commands, cmd_vel = [], [], []
+    statuses, commands, cmd_vel, response = [], [], [], {}
     with rosbag.Bag(str(path)) as bag:
         for topic, msg, t in bag.read_messages():
             if topic.endswith("/ground_truth"):
@@ -78,7 +79,12 @@ def read_bag(path):
                 commands.append((msg.header.stamp.to_sec(), msg.accel.linear.x, msg.accel.linear.y))
             elif topic == "/robot_1/cmd_vel":
                 cmd_vel.append((t.to_sec(), msg.linear.x, msg.angular.z))
-    return truth, statuses, commands, cmd_vel
+            elif topic == "/diagnostics":
+                for status in msg.status:  # the command adapter's estimate of its vehicle
+                    values = {kv.key: kv.value for kv in status.values}
+                    if "vehicle_realised_fraction" in values:
+                        response.update(values)
+    return truth, statuses, commands, cmd_vel, response
 
 
 def look_ahead_state(s, l):
@@ -121,7 +127,7 @@ def accel_ratio(follower, commands, l, step, window):
 
 def analyse(bag, case, look_ahead, window):
     vehicle, _, step, _, _ = case
-    truth, statuses, commands, cmd_vel = read_bag(bag)
+    truth, statuses, commands, cmd_vel, response = read_bag(bag)
     both = sorted(set(truth["robot_0"]) & set(truth["robot_1"]))
     if not both or not statuses:
         raise RuntimeError("no ground truth or no status recorded")
@@ -148,6 +154,10 @@ def analyse(bag, case, look_ahead, window):
         "accel_ratio": ratio,
         "accel_windows": windows,
         "limited_fraction": limited / len(cmd_vel) if cmd_vel else float("nan"),
+        # What the command adapter estimated of its vehicle (doc/vehicles.md).
+        "adapter_update": float(response.get("vehicle_update_interval (s)", "nan")),
+        "adapter_delay": float(response.get("vehicle_response_delay (s)", "nan")),
+        "adapter_realised": float(response.get("vehicle_realised_fraction", "nan")),
         # Whether the bag saw the leader at rest (recorded before it started) or already moving.
         "recorded_from": "start" if math.hypot(first_leader[3], first_leader[4]) < 1e-3 else "late",
     }
@@ -206,7 +216,8 @@ def fmt(value, digits=3):
 def markdown(rows):
     head = ("| vehicle | input | step (s) | heading (°) | push | tracking statuses | max ‖ξ‖ (m) "
             "| ξ_max (m) | min controlled points (m) | min centres (m) | perimeter α‖d‖ (m) "
-            "| a_real/a_cmd | at a wheel limit | result |")
+            "| a_real/a_cmd | at a wheel limit | adapter: update (s) | delay (s) "
+            "| realised | result |")
     lines = [head, "|" + "---|" * (head.count("|") - 1)]
     for r in rows:
         lines.append("| " + " | ".join([
@@ -215,7 +226,8 @@ def markdown(rows):
             fmt(r.get("xi_max")), fmt(r.get("min_controlled")), fmt(r.get("min_centres")),
             fmt(r.get("perimeter")), fmt(r.get("accel_ratio"), 2),
             fmt(100.0 * r["limited_fraction"], 0) + " %" if "limited_fraction" in r else "",
-            r["result"]]) + " |")
+            fmt(r.get("adapter_update"), 3), fmt(r.get("adapter_delay"), 2),
+            fmt(r.get("adapter_realised"), 2), r["result"]]) + " |")
     return "\n".join(lines) + "\n"
 
 

@@ -9,8 +9,8 @@ namespace projection_collision_avoidance {
 namespace {
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
-/// ⟨‖Δc‖²⟩ below this ((m/s)²) says too little about the realised fraction.
-constexpr double kMinExcitation = 1e-6;
+/// Changes that asked for an acceleration before the realised fraction is given.
+constexpr int kMinExcitedChanges = 10;
 /// Another delay is taken only when its error is below this fraction of the current one's.
 constexpr double kSwitchRatio = 0.8;
 
@@ -33,6 +33,11 @@ VehicleResponseEstimator::VehicleResponseEstimator(const ResponseEstimatorOption
     throw ParameterError("vehicle.velocity.averaging_time",
                          "must be finite and > 0 s, got " + std::to_string(options.averaging_time));
   }
+  if (!(options.min_acceleration >= 0.0) || !std::isfinite(options.min_acceleration)) {
+    throw ParameterError(
+        "vehicle.velocity.min_acceleration",
+        "must be finite and >= 0 m/s², got " + std::to_string(options.min_acceleration));
+  }
   candidates_ = static_cast<int>(std::floor(options.max_delay / options.period + 1e-9)) + 1;
   reset();
 }
@@ -44,6 +49,7 @@ void VehicleResponseEstimator::reset() {
   previous_time_ = 0.0;
   cross_ = 0.0;
   commanded_ = 0.0;
+  excited_ = 0;
   response_ = VehicleResponse();
 }
 
@@ -91,10 +97,16 @@ void VehicleResponseEstimator::observe(const AxisVector& velocity, double change
   if (previous_.size() == velocity.size()) {
     const AxisVector commanded =
         history.incrementBetween(previous_time_ - response_.delay, changed_at - response_.delay);
-    const AxisVector realised = velocity - previous_;
-    cross_ += weight * (realised.dot(commanded) - cross_);
-    commanded_ += weight * (commanded.squaredNorm() - commanded_);
-    response_.realised_fraction = commanded_ >= kMinExcitation
+    // Only changes that asked for an acceleration: at rest or cruising, the noise of Δv would
+    // make the ratio.
+    const double dt = changed_at - previous_time_;
+    if (commanded.norm() >= options_.min_acceleration * dt) {
+      const AxisVector realised = velocity - previous_;
+      cross_ += weight * (realised.dot(commanded) - cross_);
+      commanded_ += weight * (commanded.squaredNorm() - commanded_);
+      ++excited_;
+    }
+    response_.realised_fraction = excited_ >= kMinExcitedChanges && commanded_ > 0.0
                                       ? cross_ / commanded_
                                       : std::numeric_limits<double>::quiet_NaN();
   }

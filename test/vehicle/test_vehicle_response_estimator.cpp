@@ -81,6 +81,9 @@ TEST(VehicleResponseEstimator, RefusesUnusableOptions) {
   EXPECT_EQ(refusedKey(o), "");
   o.averaging_time = 0.0;
   EXPECT_EQ(refusedKey(o), "vehicle.velocity.averaging_time");
+  o = ResponseEstimatorOptions();
+  o.min_acceleration = -0.01;
+  EXPECT_EQ(refusedKey(o), "vehicle.velocity.min_acceleration");
 }
 
 TEST(VehicleResponseEstimator, FindsTheHoldAndTheDelayOfAVehicleSlowerThanItsCommands) {
@@ -117,6 +120,24 @@ TEST(VehicleResponseEstimator, SaysNothingOfTheFractionWhileTheCommandsAreConsta
   EXPECT_TRUE(std::isnan(r.realised_fraction));
   EXPECT_EQ(r.delay, 0.0);  // all candidates equal: the first one stays
   EXPECT_GT(r.observations, 90U);
+}
+
+/// A vehicle at rest after a manoeuvre: its velocity noise (±2 mm/s) with no command asking for
+/// anything does not move the fraction measured while it manoeuvred.
+TEST(VehicleResponseEstimator, RestAfterAManoeuvreKeepsTheFraction) {
+  VehicleResponseEstimator e = estimator();
+  VehicleRun run;
+  run.duration = 5.0;
+  const double manoeuvring = run(&e).realised_fraction;
+  ASSERT_NEAR(manoeuvring, 1.0, 0.02);
+  CommandHistory history(256, 1);
+  history.push(5.0, vec(0.0), vec(0.0));
+  for (int k = 1; k <= 100; ++k) {  // 10 s at rest, a state every 0.1 s
+    const double t = 5.0 + 0.1 * k;
+    history.push(t + 1e-6, vec(0.0), vec(0.0));
+    e.observe(vec(k % 2 == 0 ? 0.002 : -0.002), t, history);
+  }
+  EXPECT_EQ(e.response().realised_fraction, manoeuvring);
 }
 
 TEST(VehicleResponseEstimator, ALongerDelayThanItConsidersIsNotInvented) {

@@ -17,6 +17,9 @@ struct ResponseEstimatorOptions {
   double period = 0.01;         ///< T (s), > 0: candidate delays are 0, T, 2T, …
   double max_delay = 0.3;       ///< s, ≥ 0: the longest delay considered; ≤ 255 T
   double averaging_time = 1.0;  ///< s, > 0: the memory of the averages
+  /// m/s², ≥ 0: a change counts for the realised fraction when its commands asked for at least
+  /// this acceleration (‖Δc‖ ≥ min_acceleration Δt)
+  double min_acceleration = 0.05;
 };
 
 /// What the estimator has seen so far.
@@ -34,8 +37,9 @@ struct VehicleResponse {
 /// The delay is the L of least e_L; it changes only when another candidate's e is below 0.8 of
 /// the current one's, so that noise among near-equal candidates (constant commands) does not
 /// move it. The realised fraction is ρ = ⟨Δv · Δc⟩ / ⟨‖Δc‖²⟩ over the same averages, with
-/// Δv = v − v_previous and Δc = Σ of the increments sent in (t_previous − L, t_m − L]; it is NaN
-/// while ⟨‖Δc‖²⟩ < 10⁻⁶ (m/s)². Assumed: a vehicle that realises its command after a pure
+/// Δv = v − v_previous and Δc = Σ of the increments sent in [t_previous − L, t_m − L), averaged
+/// over the changes whose commands asked for an acceleration (‖Δc‖ ≥ min_acceleration Δt); it is
+/// NaN until 10 such changes were seen. Assumed: a vehicle that realises its command after a pure
 /// delay (its velocity loop faster than its state updates) and unit gain (a weaker vehicle biases
 /// the delay: 0.08 s for 0.1 s at a gain of 0.6); a first-order lag τ shows as a delay
 /// of about τ. Allocates nothing after construction.
@@ -68,6 +72,7 @@ class VehicleResponseEstimator {
   double previous_time_ = 0.0;
   double cross_ = 0.0;      ///< ⟨Δv · Δc⟩
   double commanded_ = 0.0;  ///< ⟨‖Δc‖²⟩
+  int excited_ = 0;         ///< changes that asked for an acceleration
   VehicleResponse response_;
 };
 

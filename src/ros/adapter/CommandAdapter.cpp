@@ -17,6 +17,9 @@
 namespace projection_collision_avoidance {
 namespace {
 
+/// Below this realised fraction of the commanded velocity change the diagnostics warn.
+constexpr double kMinRealisedFraction = 0.8;
+
 /// Steady (monotonic) time in s, the watchdog's clock.
 double steadySeconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -180,6 +183,20 @@ void CommandAdapter::diagnose(diagnostic_updater::DiagnosticStatusWrapper& statu
   status.add("rejected_odometry", odometry_timeline_.rejected());
   status.add("superseded_odometry", odometry_timeline_.superseded());
   status.add("max_future_stamp (s)", options_->max_future_stamp);
+  // How the vehicle follows the velocity commands (VehicleResponseEstimator, doc/vehicles.md).
+  const VehicleResponse& response = converter_.response();
+  status.add("vehicle_update_interval (s)", response.update_interval);
+  status.add("vehicle_response_delay (s)", converter_.delay());
+  status.add("vehicle_realised_fraction", response.realised_fraction);
+  if (options_->twist || options_->twist_stamped || options_->unicycle) {
+    if (response.realised_fraction < kMinRealisedFraction) {
+      status.mergeSummary(
+          DiagnosticStatus::WARN,
+          "the vehicle realises " + std::to_string(response.realised_fraction) +
+              " of the commanded velocity change: a lagging velocity loop (~velocity/lag) or a "
+              "limit below the command");
+    }
+  }
 }
 
 void CommandAdapter::publish(const ConvertedCommand& command, const ros::Time& stamp) {

@@ -80,6 +80,12 @@ CommandAdapterOptions readCommandAdapterOptions(NodeOptionReader& reader) {
   c.velocity.max_speed = limitOrNone(reader, "velocity/max_speed", 1e4);
   c.velocity.velocity_lag = reader.number("velocity/lag", 0.0, 0.0, 3600.0);
   c.velocity.max_measurement_age = c.max_odometry_age;
+  // The response delay: < 0 estimated from the odometry against the commands sent.
+  c.velocity.max_delay =
+      reader.number("velocity/max_delay", c.velocity.max_delay, 0.0, 255.0 * c.period);
+  c.velocity.delay = reader.number("velocity/delay", c.velocity.delay, -1.0, c.velocity.max_delay);
+  c.velocity.averaging_time =
+      reader.number("velocity/averaging_time", c.velocity.averaging_time, 1e-3, 3600.0);
   const std::string frame = reader.text("velocity/frame", "world");
   if (frame != "world" && frame != "base") {
     throw ParameterError("~velocity/frame", "must be \"world\" or \"base\", got \"" + frame + "\"");

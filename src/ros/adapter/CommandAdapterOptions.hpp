@@ -28,8 +28,9 @@ struct CommandAdapterOptions {
 /// accel_enu, twist, twist_stamped, unicycle; twist and unicycle both publish cmd_vel and are
 /// refused together), ~axes, ~control_rate, ~command_timeout, ~watchdog_rate, ~max_future_stamp,
 /// ~odometry/max_age, ~odometry/twist_frame, ~velocity/max_speed, ~velocity/lag,
-/// ~velocity/frame, ~unicycle/look_ahead, ~unicycle/max_speed, ~unicycle/max_yaw_rate,
-/// ~stop_deceleration, ~base_frame, ~world_frame.
+/// ~velocity/delay, ~velocity/max_delay, ~velocity/averaging_time, ~velocity/frame,
+/// ~unicycle/look_ahead, ~unicycle/max_speed, ~unicycle/max_yaw_rate, ~stop_deceleration,
+/// ~base_frame, ~world_frame.
 CommandAdapterOptions readCommandAdapterOptions(NodeOptionReader& reader);
 
 }  // namespace projection_collision_avoidance
