@@ -10,10 +10,28 @@
 
 namespace projection_collision_avoidance {
 
+std::string ownFrameLabelReason(const std::string& frame, const std::string& frame_key) {
+  const std::string name = boundedText(frame, InputGuard::kMaxQuotedLength);
+  return "header.frame_id \"" + name +
+         "\" is also the child_frame_id: a frame's pose in itself is the identity, so this is "
+         "a pose in another frame under the robot's name (ground truth labelled with the "
+         "robot's frame): set ~odometry/pose_frame to \"world\" to take the pose (and a "
+         "header-frame twist) in the frame " +
+         frame_key + " names, or publish the odometry with the frame its pose is in";
+}
+
 bool odometryInFrame(const nav_msgs::Odometry& msg, const std::string& world_frame,
-                     bool twist_in_body_frame, const tf2_ros::Buffer& tf_buffer, double tf_timeout,
+                     bool twist_in_body_frame, PoseFrame pose_frame,
+                     const tf2_ros::Buffer& tf_buffer, double tf_timeout,
                      const std::string& frame_key, OdometrySample* sample, std::string* why) {
   *sample = toOdometrySample(msg);
+  if (pose_frame == PoseFrame::kWorld) {  // in the world frame, whatever the label says
+    return true;
+  }
+  if (labelledWithItsOwnFrame(msg.header.frame_id, msg.child_frame_id)) {
+    *why = ownFrameLabelReason(msg.header.frame_id, frame_key);
+    return false;
+  }
   if (world_frame.empty() || sameFrame(msg.header.frame_id, world_frame)) {
     return true;
   }
