@@ -13,11 +13,9 @@ namespace projection_collision_avoidance {
 std::string ownFrameLabelReason(const std::string& frame, const std::string& frame_key) {
   const std::string name = boundedText(frame, InputGuard::kMaxQuotedLength);
   return "header.frame_id \"" + name +
-         "\" is also the child_frame_id: a frame's pose in itself is the identity, so this is "
-         "a pose in another frame under the robot's name (ground truth labelled with the "
-         "robot's frame): set ~odometry/pose_frame to \"world\" to take the pose (and a "
-         "header-frame twist) in the frame " +
-         frame_key + " names, or publish the odometry with the frame its pose is in";
+         "\" is also the child_frame_id, and a frame's pose in itself is the identity (ground "
+         "truth under the robot's frame?): set ~odometry/pose_frame world to take the pose in " +
+         frame_key;
 }
 
 bool odometryInFrame(const nav_msgs::Odometry& msg, const std::string& world_frame,

@@ -291,9 +291,12 @@ class HostileVehicleInputs(unittest.TestCase):
             seen[:] = [(list(s.xi), list(s.headway_command)) for s in tracking[-1:]]
             return any(near(s.xi, want_xi) and near(s.headway_command, want_headway)
                        for s in tracking)
-        self.wait_for(measured, f"the follower on ground truth with ~odometry/pose_frame world "
-                                f"does not measure xi {want_xi} with the headway term "
-                                f"{want_headway}; latest (xi, headway): {seen}")
+        end = time.monotonic() + self.deadline
+        while time.monotonic() < end and not measured():
+            pass
+        self.assertTrue(measured(), f"the follower on ground truth with ~odometry/pose_frame "
+                                    f"world does not measure xi {want_xi} with the headway term "
+                                    f"{want_headway}; latest (xi, headway): {seen}")
 
         speed = rospy.get_param("~truth_speed")
         def headed():
