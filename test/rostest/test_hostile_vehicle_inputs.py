@@ -9,12 +9,7 @@ far back, the largest ros::Time; frames empty, wrong, 100,000 characters long; v
 infinite, huge, a zero quaternion. Then every node must answer a ping and do its job with good
 messages: the followers track, the adapter converts a command, the plant drives the unicycle on
 a Twist and on a TwistStamped (and refuses one stamped an hour ahead).
-Odometry as some simulator bridges publish ground truth (pose and twist in the world under the
-robot's own frame, header.frame_id = child_frame_id) goes to a follower and an adapter with
-~odometry/pose_frame world, which must measure and head as the world poses say, and to a
-follower and an adapter with the default, which must refuse it naming ~odometry/pose_frame.
-Parameters: ~seed, ~messages, ~wall_deadline, ~nodes; ~truth_xi, ~truth_headway (the follower's
-xi and headway term on the ground truth), ~truth_speed (the adapter's v), ~truth_tolerance.
+Parameters: ~seed, ~messages, ~wall_deadline, ~nodes.
 """
 
 import math
@@ -29,7 +24,6 @@ import rospy
 import rostest
 from geometry_msgs.msg import AccelStamped, PointStamped, PoseStamped, Twist, TwistStamped
 from diagnostic_msgs.msg import DiagnosticArray
-from rosgraph_msgs.msg import Log
 from nav_msgs.msg import Odometry
 from projection_collision_avoidance.msg import FollowerStatus
 
@@ -65,22 +59,7 @@ class HostileVehicleInputs(unittest.TestCase):
         rospy.Subscriber("/adapter/cmd_vel", Twist, cls.keep(cls.twists))
         rospy.Subscriber("/follower/odom", Odometry, cls.keep(cls.plant_odometry))
         cls.diagnostics = {}  # status name -> {key: value}, the latest
-        cls.summaries = {}  # status name -> its message, the latest
         rospy.Subscriber("/diagnostics", DiagnosticArray, cls.on_diagnostics, queue_size=100)
-        # Ground truth under the robots' own frames (group truth: ~odometry/pose_frame world;
-        # truth_header: the default).
-        cls.truth_own = pub("/hostile/truth_own_odom", Odometry)
-        cls.truth_target = pub("/hostile/truth_target_odom", Odometry)
-        cls.truth_adapter_odom = pub("/hostile/truth_adapter_odom", Odometry)
-        cls.truth_command = pub("/hostile/truth_command", AccelStamped)
-        cls.truth_statuses, cls.header_statuses = [], []
-        cls.truth_twists, cls.header_twists = [], []
-        cls.header_warnings = []
-        rospy.Subscriber("/truth/status", FollowerStatus, cls.keep(cls.truth_statuses))
-        rospy.Subscriber("/truth_header/status", FollowerStatus, cls.keep(cls.header_statuses))
-        rospy.Subscriber("/truth/cmd_vel", Twist, cls.keep(cls.truth_twists))
-        rospy.Subscriber("/truth_header/cmd_vel", Twist, cls.keep(cls.header_twists))
-        rospy.Subscriber("/rosout", Log, cls.on_log, queue_size=1000)
 
     @classmethod
     def on_diagnostics(cls, msg):
@@ -88,13 +67,6 @@ class HostileVehicleInputs(unittest.TestCase):
             for status in msg.status:  # named "<node>: <task>", the node's leading slash or not
                 node = status.name.split(":")[0].lstrip("/")
                 cls.diagnostics[node] = {v.key: v.value for v in status.values}
-                cls.summaries[node] = status.message
-
-    @classmethod
-    def on_log(cls, msg):
-        if msg.name == "/truth_header/controller" and msg.level >= Log.WARN:
-            with cls.lock:
-                cls.header_warnings.append(msg.msg)
 
     def counts(self):
         """(follower's rejected and superseded odometry, adapter's), from the latest
@@ -252,84 +224,6 @@ class HostileVehicleInputs(unittest.TestCase):
         self.wait_for(driven_stamped, "the plant does not hold a good TwistStamped and refuse one "
                                       "stamped ahead")
 
-
-    @staticmethod
-    def truth_odometry(frame, stamp, x, y, yaw, forward):
-        """Ground truth as some bridges label it: header.frame_id @p frame (the robot's own),
-        child_frame_id the same without its leading slash; the pose (x, y, yaw) in the world, a
-        body twist @p forward along x (a unicycle's)."""
-        msg = Odometry()
-        msg.header.stamp, msg.header.frame_id, msg.child_frame_id = stamp, frame, frame.lstrip("/")
-        msg.pose.pose.position.x, msg.pose.pose.position.y = x, y
-        msg.pose.pose.orientation.z = math.sin(yaw / 2)
-        msg.pose.pose.orientation.w = math.cos(yaw / 2)
-        msg.twist.twist.linear.x = forward
-        return msg
-
-    def test_ground_truth_under_the_robots_own_frame(self):
-        """With ~odometry/pose_frame world the follower measures xi from the world poses, its
-        time headway turns the body twist by the world yaw, and the adapter heads by it; with
-        the default both refuse the messages naming ~odometry/pose_frame."""
-        for publisher in (self.truth_own, self.truth_target, self.truth_adapter_odom,
-                          self.truth_command):
-            self.wait_for(lambda p=publisher: p.get_num_connections() >= 2, f"{publisher.name}")
-        tolerance = rospy.get_param("~truth_tolerance")
-        want_xi, want_headway = rospy.get_param("~truth_xi"), rospy.get_param("~truth_headway")
-        near = lambda got, want: len(got) == len(want) and all(  # noqa: E731
-            abs(g - w) <= tolerance for g, w in zip(got, want))
-        seen = []
-
-        def measured():
-            stamp = rospy.Time.now()  # one stamp: the pair needs no alignment
-            self.truth_target.publish(self.truth_odometry("robot_0", stamp, 6.3, 1.8, 0.0, 0.5))
-            self.truth_own.publish(self.truth_odometry("/robot_1/base_link", stamp, 1.0, 2.0,
-                                                       math.pi / 2, 0.4))
-            time.sleep(0.01)
-            with self.lock:
-                tracking = [s for s in self.truth_statuses
-                            if s.mode == FollowerStatus.MODE_TRACKING and s.own_state_fresh]
-            seen[:] = [(list(s.xi), list(s.headway_command)) for s in tracking[-1:]]
-            return any(near(s.xi, want_xi) and near(s.headway_command, want_headway)
-                       for s in tracking)
-        end = time.monotonic() + self.deadline
-        while time.monotonic() < end and not measured():
-            pass
-        self.assertTrue(measured(), f"the follower on ground truth with ~odometry/pose_frame "
-                                    f"world does not measure xi {want_xi} with the headway term "
-                                    f"{want_headway}; latest (xi, headway): {seen}")
-
-        speed = rospy.get_param("~truth_speed")
-        def headed():
-            odometry = self.truth_odometry("robot_1", rospy.Time.now(), 0.0, 0.0, math.pi / 2, 0.0)
-            self.truth_adapter_odom.publish(odometry)
-            command = AccelStamped()
-            command.header.stamp, command.header.frame_id = rospy.Time.now(), "world"
-            command.accel.linear.y = 1.0
-            self.truth_command.publish(command)
-            time.sleep(0.01)
-            with self.lock:
-                return any(abs(t.linear.x - speed) <= tolerance and abs(t.angular.z) <= tolerance
-                           for t in self.truth_twists)
-        self.wait_for(headed, "the adapter on ground truth with ~odometry/pose_frame world does "
-                              "not drive along its world heading")
-
-        # The same messages, without ~odometry/pose_frame: refused, named, never used.
-        def refused():
-            with self.lock:
-                warnings = [w for w in self.header_warnings if "~odometry/pose_frame" in w]
-                follower = self.diagnostics.get("truth_header/controller", {})
-                summary = self.summaries.get("truth_header/adapter", "")
-            return (warnings and int(follower.get("rejected_input_messages", 0)) > 0 and
-                    int(follower.get("rejected_odometry", 0)) > 0 and
-                    "~odometry/pose_frame" in summary)
-        self.wait_for(refused, "the follower (WARN, input and headway odometry counts) or the "
-                               "adapter (diagnostics) with ~odometry/pose_frame header does not "
-                               "refuse ground truth under the robot's frame naming the parameter")
-        with self.lock:
-            self.assertFalse(self.header_statuses, "the follower with ~odometry/pose_frame "
-                                                   "header used ground truth under robot frames")
-            self.assertFalse([t for t in self.header_twists if t.linear.x or t.angular.z],
-                             "the adapter with ~odometry/pose_frame header moved its robot")
 
     def test_reordered_odometry_is_superseded_not_refused(self):
         """Good odometry on the follower's two topics and the adapter's, every message sent
