@@ -10,10 +10,26 @@
 
 namespace projection_collision_avoidance {
 
+std::string ownFrameLabelReason(const std::string& frame, const std::string& frame_key) {
+  const std::string name = boundedText(frame, InputGuard::kMaxQuotedLength);
+  return "header.frame_id \"" + name +
+         "\" is also the child_frame_id, and a frame's pose in itself is the identity (ground "
+         "truth under the robot's frame?): set ~odometry/pose_frame world to take the pose in " +
+         frame_key;
+}
+
 bool odometryInFrame(const nav_msgs::Odometry& msg, const std::string& world_frame,
-                     bool twist_in_body_frame, const tf2_ros::Buffer& tf_buffer, double tf_timeout,
+                     bool twist_in_body_frame, PoseFrame pose_frame,
+                     const tf2_ros::Buffer& tf_buffer, double tf_timeout,
                      const std::string& frame_key, OdometrySample* sample, std::string* why) {
   *sample = toOdometrySample(msg);
+  if (pose_frame == PoseFrame::kWorld) {  // in the world frame, whatever the label says
+    return true;
+  }
+  if (labelledWithItsOwnFrame(msg.header.frame_id, msg.child_frame_id)) {
+    *why = ownFrameLabelReason(msg.header.frame_id, frame_key);
+    return false;
+  }
   if (world_frame.empty() || sameFrame(msg.header.frame_id, world_frame)) {
     return true;
   }

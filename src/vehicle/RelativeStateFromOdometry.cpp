@@ -48,6 +48,22 @@ const char* toString(OdometryVerdict verdict) {
   return "unknown";
 }
 
+const char* toString(PoseFrame frame) { return frame == PoseFrame::kWorld ? "world" : "header"; }
+
+PoseFrame poseFrameOf(const std::string& value) {
+  if (value == "header") {
+    return PoseFrame::kHeader;
+  }
+  if (value == "world") {
+    return PoseFrame::kWorld;
+  }
+  throw ParameterError("~odometry/pose_frame",
+                       "must be \"header\" (the pose in header.frame_id, REP 105) or \"world\" "
+                       "(the pose in the node's world frame whatever header.frame_id says), "
+                       "got \"" +
+                           value + "\"");
+}
+
 Eigen::Matrix<double, 6, 1> bodyPointState(const OdometrySample& sample, const Eigen::Vector3d& r,
                                            TwistFrame twist_frame) {
   const Eigen::Matrix3d rotation = sample.orientation.toRotationMatrix();
@@ -65,6 +81,30 @@ Eigen::Matrix<double, 6, 1> bodyPointState(const OdometrySample& sample, const E
     state.tail<3>() += omega.cross(offset);
   }
   return state;
+}
+
+OdometryVerdict originState(const OdometrySample& sample, TwistFrame twist_frame,
+                            double quaternion_tolerance, int axes, PlanarOrSpatialState* state) {
+  const bool body = twist_frame == TwistFrame::kBody;
+  if (!sample.position.allFinite() || !sample.linear_velocity.allFinite() ||
+      (body && !sample.orientation.coeffs().allFinite())) {
+    return OdometryVerdict::kSelfNotFinite;
+  }
+  Eigen::Vector3d velocity = sample.linear_velocity;
+  if (body) {
+    Eigen::Quaterniond q = sample.orientation;
+    if (normaliseQuaternion(q, quaternion_tolerance) != QuaternionStatus::kUnit) {
+      return OdometryVerdict::kSelfQuaternionNotUnit;
+    }
+    velocity = q.toRotationMatrix() * velocity;
+    if (!velocity.allFinite()) {
+      return OdometryVerdict::kOverflow;
+    }
+  }
+  *state = PlanarOrSpatialState::Zero(2 * axes);
+  state->head(axes) = sample.position.head(axes);
+  state->tail(axes) = velocity.head(axes);
+  return OdometryVerdict::kAccepted;
 }
 
 RelativeStateFromOdometry::RelativeStateFromOdometry(const OdometryAlignmentOptions& options)

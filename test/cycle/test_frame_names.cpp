@@ -26,5 +26,16 @@ TEST(FrameNames, SameFrameUpToALeadingSlashEach) {
   EXPECT_FALSE(sameFrame("world/", "world"));
 }
 
+TEST(FrameNames, AnOdometryLabelledWithItsOwnFrameNamesOneFrameTwice) {
+  EXPECT_TRUE(labelledWithItsOwnFrame("robot_0", "robot_0"));
+  EXPECT_TRUE(labelledWithItsOwnFrame("/robot_0/base_link", "robot_0/base_link"));
+  EXPECT_FALSE(labelledWithItsOwnFrame("world", "robot_0/base_link"));
+  EXPECT_FALSE(labelledWithItsOwnFrame("robot_0/odom", "robot_0/base_link"));
+  // No name at all is no label: such a message is judged by its frames elsewhere.
+  EXPECT_FALSE(labelledWithItsOwnFrame("", ""));
+  EXPECT_FALSE(labelledWithItsOwnFrame("/", ""));
+  EXPECT_FALSE(labelledWithItsOwnFrame("//a", "a"));
+}
+
 }  // namespace
 }  // namespace projection_collision_avoidance

@@ -1,6 +1,7 @@
 #!/usr/bin/python3
-"""rostest: the follower, the plant and the leader refuse invalid parameters. For every case each
-node that reads the spoiled parameter must exit with code 1 (not 0, not a signal) within a
+"""rostest: the follower, the plant, the leader and the command adapter refuse invalid parameters
+(the adapter in its own cases, as it reads no scenario). For every case each node that reads
+the spoiled parameter must exit with code 1 (not 0, not a signal) within a
 deadline, printing "invalid parameter <key>: <reason>" where <key> is the parameter's full name
 ("~scenario/controller/alpha", "~measurement_timeout"); a node that starts instead (logs that it
 is running) fails the case at once.
@@ -45,11 +46,13 @@ PARALLEL = 12  # node processes at a time (they mostly wait on the master, not o
 
 FOLLOWER, PLANT, LEADER = "follower_node", "plant_node", "leader_node"
 ALL_NODES = (FOLLOWER, PLANT, LEADER)
+ADAPTER = "command_adapter"  # reads no scenario: only its own cases name it
 # What each node logs once it runs, i.e. once it has accepted its parameters.
 RUNNING = {
     FOLLOWER: ", running at ",
     PLANT: ": simulating a leader",
     LEADER: ": playing the leader's input",
+    ADAPTER: "from command, stop after",
 }
 NAN, INF = math.nan, math.inf
 MISSING = object()  # the ~scenario parameter is not set at all
@@ -561,6 +564,10 @@ def on_thread(name, key, value):
     return case(name, "~" + key, options={"control_loop": "thread", key: value}, nodes=(FOLLOWER,))
 
 
+# Run 2 with a time headway: the follower subscribes its own odometry (odom).
+HEADWAY = S("controller.spacing", {"time_headway": 0.3})
+
+
 def on_input(name, key, source, **options):
     """A follower on ~input @p source with @p options ("group/key" nested), refused naming
     @p key."""
@@ -578,6 +585,22 @@ NODE_OPTIONS = [
              **{"odometry/twist_frame": "map"}),
     on_input("odometry max_skew < 0", "odometry/max_skew", "odometry",
              **{"odometry/max_skew": -0.1}),
+    on_input("odometry pose_frame unknown", "odometry/pose_frame", "odometry",
+             measurement_frame="world", **{"odometry/pose_frame": "map"}),
+    on_input("odometry pose_frame world without a world frame", "measurement_frame",
+             "odometry", **{"odometry/pose_frame": "world"}),
+    # the time headway's own odometry (S1) reads the odometry conventions too
+    case("time headway: odometry pose_frame unknown", "~odometry/pose_frame", HEADWAY,
+         options={"odometry": {"pose_frame": "child"}}, nodes=(FOLLOWER,)),
+    case("time headway: odometry twist_frame unknown", "~odometry/twist_frame", HEADWAY,
+         options={"odometry": {"twist_frame": "world"}}, nodes=(FOLLOWER,)),
+    # command_adapter: the own odometry's conventions
+    case("adapter odometry pose_frame unknown", "~odometry/pose_frame",
+         options={"odometry": {"pose_frame": "World"}}, nodes=(ADAPTER,)),
+    case("adapter odometry pose_frame world without a world frame", "~world_frame",
+         options={"odometry": {"pose_frame": "world"}}, nodes=(ADAPTER,)),
+    case("adapter odometry twist_frame unknown", "~odometry/twist_frame",
+         options={"odometry": {"twist_frame": "world"}}, nodes=(ADAPTER,)),
     on_input("tf without a world frame", "measurement_frame", "tf",
              **{"tf/self_frame": "follower", "tf/target_frame": "leader"}),
     on_input("tf without its own frame", "tf/self_frame", "tf", measurement_frame="world",
@@ -966,6 +989,26 @@ class InvalidParameters(unittest.TestCase):
                            reasons=("Operation not permitted", "Cannot allocate memory"))
 
     # --- valid parameters are accepted ---------------------------------------------------------
+
+    def test_odometry_conventions_are_accepted(self):
+        """~odometry/pose_frame world starts the follower on odometry with ~measurement_frame,
+        the follower with a time headway alone (whose own odometry needs no world frame), and the
+        command adapter with ~world_frame."""
+        cases = [
+            case("odometry input, pose_frame world", None,
+                 options={"input": "odometry", "measurement_frame": "world",
+                          "odometry": {"pose_frame": "world", "twist_frame": "header"}},
+                 nodes=(FOLLOWER,)),
+            case("time headway, pose_frame world", None, HEADWAY,
+                 options={"odometry": {"pose_frame": "world"}}, nodes=(FOLLOWER,)),
+            case("adapter, pose_frame world", None,
+                 options={"world_frame": "world", "odometry": {"pose_frame": "world"}},
+                 nodes=(ADAPTER,)),
+        ]
+        for c, node, r in self.run_cases(cases):
+            self.assertEqual(r.outcome, "running", f"[{node}] {c.name}:\n{r.output}")
+            self.assertTrue(r.stopped, f"[{node}] {c.name}: SIGINT did not end it")
+
 
     def test_whole_numbers_where_reals_are_expected_are_accepted(self):
         """alpha: 0, control_rate: 100 and the like (YAML integers) are valid: each node starts.

@@ -254,6 +254,67 @@ TEST(RelativeStateFromOdometry, NonFiniteValuesRefusedNeverThrown) {
   EXPECT_TRUE(r.state.isZero(0.0));
 }
 
+TEST(PoseFrame, ReadsItsTwoNamesAndRefusesOthersNamingTheKey) {
+  EXPECT_EQ(poseFrameOf("header"), PoseFrame::kHeader);
+  EXPECT_EQ(poseFrameOf("world"), PoseFrame::kWorld);
+  EXPECT_STREQ(toString(PoseFrame::kHeader), "header");
+  EXPECT_STREQ(toString(PoseFrame::kWorld), "world");
+  for (const char* bad : {"", "body", "World", "map", "header "}) {
+    try {
+      poseFrameOf(bad);
+      ADD_FAILURE() << "accepted \"" << bad << "\"";
+    } catch (const ParameterError& e) {
+      EXPECT_EQ(e.key(), "~odometry/pose_frame");
+    }
+  }
+}
+
+TEST(OdometryOriginState, BodyTwistTurnedIntoThePoseFrameHeaderTwistAsItIs) {
+  // Yaw 90°: the body's x axis is the world's y axis.
+  const OdometrySample s =
+      sample(1.0, Eigen::Vector3d(1, 2, 3), yaw(kPi / 2), Eigen::Vector3d(0.4, 0.1, 0.5));
+  PlanarOrSpatialState x;
+  ASSERT_EQ(originState(s, TwistFrame::kBody, 1e-2, 2, &x), OdometryVerdict::kAccepted);
+  Eigen::Vector4d planar;
+  planar << 1, 2, -0.1, 0.4;
+  EXPECT_MATRIX_NEAR(x, planar, 1e-15);
+  ASSERT_EQ(originState(s, TwistFrame::kWorld, 1e-2, 2, &x), OdometryVerdict::kAccepted);
+  planar.tail<2>() << 0.4, 0.1;
+  EXPECT_MATRIX_NEAR(x, planar, 0.0);
+  ASSERT_EQ(originState(s, TwistFrame::kBody, 1e-2, 3, &x), OdometryVerdict::kAccepted);
+  Eigen::Matrix<double, 6, 1> spatial;
+  spatial << 1, 2, 3, -0.1, 0.4, 0.5;
+  EXPECT_MATRIX_NEAR(x, spatial, 1e-15);
+  ASSERT_EQ(originState(s, TwistFrame::kBody, 1e-2, 1, &x), OdometryVerdict::kAccepted);
+  EXPECT_MATRIX_NEAR(x, Eigen::Vector2d(1, -0.1), 1e-15);
+  // The orientation is the same as RelativeStateFromOdometry's (within its tolerance).
+  OdometrySample scaled = s;
+  scaled.orientation.coeffs() *= 0.995;
+  ASSERT_EQ(originState(scaled, TwistFrame::kBody, 1e-2, 2, &x), OdometryVerdict::kAccepted);
+  EXPECT_MATRIX_NEAR(x.tail(2), Eigen::Vector2d(-0.1, 0.4), 1e-15);
+}
+
+TEST(OdometryOriginState, RefusesWhatItCannotTurnNeverThrows) {
+  OdometrySample s = sample(1.0, Eigen::Vector3d(1, 2, 0), yaw(0.3), Eigen::Vector3d(1, 0, 0));
+  PlanarOrSpatialState x;
+  // The orientation matters only to a body twist.
+  s.orientation = Eigen::Quaterniond(0, 0, 0, 0);
+  EXPECT_EQ(originState(s, TwistFrame::kBody, 1e-2, 2, &x),
+            OdometryVerdict::kSelfQuaternionNotUnit);
+  EXPECT_EQ(originState(s, TwistFrame::kWorld, 1e-2, 2, &x), OdometryVerdict::kAccepted);
+  s.orientation.coeffs()(0) = kNaN;
+  EXPECT_EQ(originState(s, TwistFrame::kBody, 1e-2, 2, &x), OdometryVerdict::kSelfNotFinite);
+  EXPECT_EQ(originState(s, TwistFrame::kWorld, 1e-2, 2, &x), OdometryVerdict::kAccepted);
+  s = sample(1.0, Eigen::Vector3d(1, kInf, 0), yaw(0.3), Eigen::Vector3d(1, 0, 0));
+  EXPECT_EQ(originState(s, TwistFrame::kWorld, 1e-2, 2, &x), OdometryVerdict::kSelfNotFinite);
+  s = sample(1.0, Eigen::Vector3d(1, 2, 0), yaw(0.3), Eigen::Vector3d(kNaN, 0, 0));
+  EXPECT_EQ(originState(s, TwistFrame::kBody, 1e-2, 2, &x), OdometryVerdict::kSelfNotFinite);
+  // Finite components that overflow once turned by 45°.
+  const double big = std::numeric_limits<double>::max();
+  s = sample(1.0, Eigen::Vector3d(0, 0, 0), yaw(kPi / 4), Eigen::Vector3d(big, -big, 0));
+  EXPECT_EQ(originState(s, TwistFrame::kBody, 1e-2, 2, &x), OdometryVerdict::kOverflow);
+}
+
 TEST(RelativeStateFromOdometry, LookAheadPointsAsTheUnicycleMapGivesThem) {
   // Two unicycles controlled at look-ahead points 0.3 m and 0.5 m ahead: the relative state of
   // the body-fixed points equals the difference of UnicycleLookAhead's states.

@@ -25,4 +25,12 @@ inline bool sameFrame(std::string_view a, std::string_view b) {
   return tfFrameName(a) == tfFrameName(b);
 }
 
+/// Whether an odometry's @p header_frame (its pose's frame) and @p child_frame (its body's) name
+/// one frame, and not the empty one: the pose of a frame in itself is the identity, so such a
+/// message holds a pose in some other frame under its robot's name (a simulator's ground truth,
+/// for instance, whose pose is in the world).
+inline bool labelledWithItsOwnFrame(std::string_view header_frame, std::string_view child_frame) {
+  return !tfFrameName(header_frame).empty() && sameFrame(header_frame, child_frame);
+}
+
 }  // namespace projection_collision_avoidance

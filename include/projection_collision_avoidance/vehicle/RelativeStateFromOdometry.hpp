@@ -6,6 +6,9 @@
 /// the two samples aligned to a common time. The input of the follower's `odometry` adapter
 /// (doc/vehicles.md).
 
+#include <cstdint>
+#include <string>
+
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
@@ -29,6 +32,21 @@ enum class TwistFrame {
   kBody,   ///< child_frame_id, as REP 105 says (diff_drive_controller, MAVROS local_position/odom)
   kWorld,  ///< header.frame_id (some motion-capture relays); no rotation is applied
 };
+
+/// Where the pose of an odometry (and a twist in its header frame) is taken to be
+/// (~odometry/pose_frame).
+enum class PoseFrame : std::uint8_t {
+  kHeader,  ///< "header": in header.frame_id, as REP 105 says
+  kWorld,   ///< "world": in the node's world frame whatever header.frame_id says (a simulator's
+            ///< ground truth labelled with the robot's own frame)
+};
+
+/// "header" or "world".
+const char* toString(PoseFrame frame);
+
+/// The PoseFrame named @p value ("header" or "world").
+/// @throws ParameterError naming ~odometry/pose_frame for any other value
+PoseFrame poseFrameOf(const std::string& value);
 
 /// Options of RelativeStateFromOdometry.
 struct OdometryAlignmentOptions {
@@ -76,6 +94,16 @@ struct RelativeOdometryResult {
 /// v_world = R(q) v (or v for TwistFrame::kWorld) and likewise ω_world.
 Eigen::Matrix<double, 6, 1> bodyPointState(const OdometrySample& sample, const Eigen::Vector3d& r,
                                            TwistFrame twist_frame);
+
+/// The state x = [p; v] (2 · @p axes entries; m, m/s) of one odometry's origin, in the frame of
+/// its pose: p as it is, v_world = R(q) v for TwistFrame::kBody (q checked against
+/// @p quaternion_tolerance, then normalised) or v as it is for kWorld (q unused). The follower's
+/// own state for the time headway. Never throws, allocates nothing.
+/// @return kAccepted; kSelfNotFinite for a NaN or infinite position or velocity (or orientation,
+///         for a body twist); kSelfQuaternionNotUnit; kOverflow for a finite velocity whose
+///         rotation is not (components near the largest double)
+OdometryVerdict originState(const OdometrySample& sample, TwistFrame twist_frame,
+                            double quaternion_tolerance, int axes, PlanarOrSpatialState* state);
 
 /// The relative state x_target − x_self from one odometry sample of each agent.
 ///

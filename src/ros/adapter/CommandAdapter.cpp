@@ -98,8 +98,8 @@ void CommandAdapter::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
     OdometrySample sample;
     std::string why;
     if (!odometryInFrame(*msg, options_->world_frame,
-                         options_->converter.odometry_twist_frame == TwistFrame::kBody, tf_buffer_,
-                         0.0, "~world_frame", &sample, &why)) {
+                         options_->converter.odometry_twist_frame == TwistFrame::kBody,
+                         options_->pose_frame, tf_buffer_, 0.0, "~world_frame", &sample, &why)) {
       odometry_timeline_.reject(Rejection::kContent, why);
       return;
     }

@@ -102,6 +102,13 @@ CommandAdapterOptions readCommandAdapterOptions(NodeOptionReader& reader) {
   c.stop_deceleration = reader.number("stop_deceleration", c.stop_deceleration, 1e-3, 1e3);
   options.base_frame = reader.frame("base_frame", "");
   options.world_frame = reader.frame("world_frame", "");
+  options.pose_frame =
+      poseFrameOf(reader.text("odometry/pose_frame", toString(options.pose_frame)));
+  if (options.pose_frame == PoseFrame::kWorld && options.world_frame.empty()) {
+    throw ParameterError("~world_frame",
+                         "must name the world frame the odometry's pose is in with "
+                         "~odometry/pose_frame \"world\"");
+  }
   return options;
 }
 

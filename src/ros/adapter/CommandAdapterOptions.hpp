@@ -22,15 +22,17 @@ struct CommandAdapterOptions {
   std::string base_frame;  ///< frame_id of base-frame stamped outputs ("": the odometry's child)
   /// The follower's world frame (its measurements' frame); "": the own odometry's header frame.
   std::string world_frame;
+  /// ~odometry/pose_frame: the own odometry's pose in its header.frame_id, or in world_frame.
+  PoseFrame pose_frame = PoseFrame::kHeader;
 };
 
 /// The options, each validated (the message names the key): ~outputs (a space-separated set of
 /// accel_enu, twist, twist_stamped, unicycle; twist and unicycle both publish cmd_vel and are
 /// refused together), ~axes, ~control_rate, ~command_timeout, ~watchdog_rate, ~max_future_stamp,
-/// ~odometry/max_age, ~odometry/twist_frame, ~velocity/max_speed, ~velocity/lag,
-/// ~velocity/delay, ~velocity/max_delay, ~velocity/averaging_time, ~velocity/frame,
-/// ~unicycle/look_ahead, ~unicycle/max_speed, ~unicycle/max_yaw_rate, ~stop_deceleration,
-/// ~base_frame, ~world_frame.
+/// ~odometry/max_age, ~odometry/twist_frame, ~odometry/pose_frame ("world" needs ~world_frame),
+/// ~velocity/max_speed, ~velocity/lag, ~velocity/delay, ~velocity/max_delay,
+/// ~velocity/averaging_time, ~velocity/frame, ~unicycle/look_ahead, ~unicycle/max_speed,
+/// ~unicycle/max_yaw_rate, ~stop_deceleration, ~base_frame, ~world_frame.
 CommandAdapterOptions readCommandAdapterOptions(NodeOptionReader& reader);
 
 }  // namespace projection_collision_avoidance

@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <utility>
 
+#include "projection_collision_avoidance/cycle/FrameNames.hpp"
 #include "projection_collision_avoidance/ros/MessageConversions.hpp"
+#include "projection_collision_avoidance/ros/OdometryFrames.hpp"
 
 namespace projection_collision_avoidance {
 
@@ -157,10 +159,28 @@ void FollowerInputs::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
     if (!checkHeader(timeline, msg->header, now)) {
       return;
     }
-    if (!stateFromOdometryMsg(*msg, axes_, &odometry_state_)) {
-      timeline.reject(Rejection::kContent, "non-finite position or velocity");
+    // The conventions of ~odometry/pose_frame and ~odometry/twist_frame, as the odometry input
+    // reads them; the velocity stays in the axes of the pose's frame (no tf2 here: ~odom_frame
+    // can require that frame).
+    if (options_.odometry.pose_frame == PoseFrame::kHeader &&
+        labelledWithItsOwnFrame(msg->header.frame_id, msg->child_frame_id)) {
+      timeline.reject(Rejection::kContent,
+                      ownFrameLabelReason(msg->header.frame_id, "~measurement_frame"));
       return;
     }
+    const OdometryVerdict verdict =
+        originState(toOdometrySample(*msg),
+                    options_.odometry.twist_in_body_frame ? TwistFrame::kBody : TwistFrame::kWorld,
+                    options_.odometry.quaternion_tolerance, axes_, &origin_state_);
+    if (verdict != OdometryVerdict::kAccepted) {
+      timeline.reject(Rejection::kContent,
+                      verdict == OdometryVerdict::kSelfQuaternionNotUnit
+                          ? "an orientation that is not a unit quaternion, which the body-frame "
+                            "twist needs (~odometry/twist_frame body)"
+                          : "non-finite position, velocity or orientation");
+      return;
+    }
+    odometry_state_ = origin_state_;
     own_state_.stamp_ns = timeline.accept();
     own_state_.receipt_ns = nanosecondsOf(now);
     own_state_.sequence = timeline.guard().accepted();

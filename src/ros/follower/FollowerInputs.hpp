@@ -18,6 +18,7 @@
 #include "projection_collision_avoidance/cycle/InputTimeline.hpp"
 #include "projection_collision_avoidance/ros/InlineCallbackQueue.hpp"
 #include "projection_collision_avoidance/ros/InputAdmission.hpp"
+#include "projection_collision_avoidance/vehicle/RelativeStateFromOdometry.hpp"
 
 #include "follower/FollowerOptions.hpp"
 #include "follower/MeasurementAdapter.hpp"
@@ -51,7 +52,8 @@ struct FollowerInputStats {
 /// The follower's inputs: subscribes `relative_measurement` (with ~input relative_measurement;
 /// other inputs hand their measurements to admitMeasurement()), `leader_broadcast` and, with a time
 /// headway (time_headway > 0), `odom` (nav_msgs/Odometry: its own state; frame ~odom_frame,
-/// refused once older than ~measurement_timeout on arrival), judges each message with its
+/// refused once older than ~measurement_timeout on arrival; read with ~odometry/twist_frame and
+/// ~odometry/pose_frame as the odometry input reads it), judges each message with its
 /// InputTimeline (doc/boundary.md) on the subscriber's thread, and writes what it accepts into the
 /// control cycle's lock-free slots; each accepted measurement is then announced to @p on_accepted
 /// (with ~trigger measurement, MeasurementTrigger steps on it). Nothing a message carries can
@@ -110,6 +112,7 @@ class FollowerInputs {
   InputTimeline odometry_timeline_;
   OwnStateSample own_state_;
   Eigen::VectorXd odometry_state_;
+  PlanarOrSpatialState origin_state_;  ///< the own odometry's [p; v] before it is accepted
 
   // Read by other threads.
   std::atomic<const MeasurementAdapter*> adapter_{nullptr};

@@ -46,9 +46,11 @@ MeasurementInput inputOf(const std::string& value) {
                     value + "\"");
 }
 
-OdometryInputOptions readOdometryOptions(NodeOptionReader& reader) {
+/// ~odometry/...: all of them for ~input odometry (@p input), else (the time headway's own
+/// odometry) the conventions and the quaternion tolerance. @p world_frame is ~measurement_frame.
+OdometryInputOptions readOdometryOptions(NodeOptionReader& reader, bool input,
+                                         const std::string& world_frame) {
   OdometryInputOptions o;
-  o.max_skew = reader.number("odometry/max_skew", o.max_skew, 0.0, 3600.0);
   o.quaternion_tolerance =
       reader.number("odometry/quaternion_tolerance", o.quaternion_tolerance, 0.0, 1.0);
   const std::string frame = reader.text("odometry/twist_frame", "body");
@@ -59,6 +61,16 @@ OdometryInputOptions readOdometryOptions(NodeOptionReader& reader) {
                              frame + "\"");
   }
   o.twist_in_body_frame = frame == "body";
+  o.pose_frame = poseFrameOf(reader.text("odometry/pose_frame", toString(o.pose_frame)));
+  if (!input) {
+    return o;
+  }
+  if (o.pose_frame == PoseFrame::kWorld && world_frame.empty()) {
+    throw ParameterError("~measurement_frame",
+                         "must name the world frame the odometries' poses are in with "
+                         "~odometry/pose_frame \"world\"");
+  }
+  o.max_skew = reader.number("odometry/max_skew", o.max_skew, 0.0, 3600.0);
   o.look_ahead = reader.number("odometry/look_ahead", o.look_ahead, 0.0, 1000.0);
   o.target_look_ahead =
       reader.number("odometry/target_look_ahead", o.target_look_ahead, 0.0, 1000.0);
@@ -146,8 +158,9 @@ FollowerNodeOptions readFollowerOptions(NodeOptionReader& reader, const Controll
   options.transport = transport == "udp" ? Transport::kUdp : Transport::kTcp;
   options.clock_skew = readClockSkewOptions(reader);
   options.input = inputOf(reader.text("input", toString(options.input)));
-  if (options.input == MeasurementInput::kOdometry) {
-    options.odometry = readOdometryOptions(reader);
+  if (options.input == MeasurementInput::kOdometry || p.time_headway > 0.0) {
+    options.odometry = readOdometryOptions(reader, options.input == MeasurementInput::kOdometry,
+                                           options.measurement_frame);
   }
   if (options.input == MeasurementInput::kPosition || options.input == MeasurementInput::kTf) {
     options.position = readPositionOptions(reader, options.input, options.measurement_frame,

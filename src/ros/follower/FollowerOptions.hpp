@@ -8,6 +8,7 @@
 #include "projection_collision_avoidance/core/Formation.hpp"
 #include "projection_collision_avoidance/cycle/StampCorrection.hpp"
 #include "projection_collision_avoidance/ros/RosParameters.hpp"
+#include "projection_collision_avoidance/vehicle/RelativeStateFromOdometry.hpp"
 
 namespace projection_collision_avoidance {
 
@@ -50,7 +51,9 @@ enum class MeasurementInput : std::uint8_t {
 /// "relative_measurement", "odometry", "position" or "tf".
 const char* toString(MeasurementInput input);
 
-/// The odometry input's options (~odometry/...; doc/vehicles.md).
+/// The odometry input's options (~odometry/...; doc/vehicles.md). With a time headway and no
+/// odometry input only the conventions (twist_frame, pose_frame) and the quaternion tolerance
+/// are read: the headway's own odometry honours them too.
 struct OdometryInputOptions {
   double max_skew = 0.05;              ///< s; largest |t_target - t_self| aligned
   double quaternion_tolerance = 1e-2;  ///< largest |norm(q) - 1| normalised
@@ -58,6 +61,8 @@ struct OdometryInputOptions {
   double look_ahead = 0.0;             ///< m; l of the own controlled point (unicycle), 0: origin
   double target_look_ahead = 0.0;      ///< m; the target's
   double tf_timeout = 0.0;             ///< s a tf lookup of another frame may wait
+  /// The pose (and a header-frame twist) in header.frame_id, or in ~measurement_frame.
+  PoseFrame pose_frame = PoseFrame::kHeader;
 };
 
 /// The position and tf inputs' options (~position/... and ~tf/...; doc/vehicles.md).

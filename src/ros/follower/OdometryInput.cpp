@@ -86,8 +86,9 @@ void OdometryInput::onOdometry(Side* side, const nav_msgs::Odometry::ConstPtr& m
     }
     std::string why;
     OdometrySample sample;
-    if (!odometryInFrame(*msg, world_frame_, options_.odometry.twist_in_body_frame, tf_buffer_,
-                         options_.odometry.tf_timeout, kFrameKey, &sample, &why)) {
+    if (!odometryInFrame(*msg, world_frame_, options_.odometry.twist_in_body_frame,
+                         options_.odometry.pose_frame, tf_buffer_, options_.odometry.tf_timeout,
+                         kFrameKey, &sample, &why)) {
       timeline.reject(Rejection::kContent, why);
       return;
     }
@@ -128,7 +129,8 @@ void OdometryInput::combine() {
     std::string why;
     OdometrySample sample;
     if (!odometryInFrame(*target_.msg, world_frame_, options_.odometry.twist_in_body_frame,
-                         tf_buffer_, options_.odometry.tf_timeout, kFrameKey, &sample, &why)) {
+                         options_.odometry.pose_frame, tf_buffer_, options_.odometry.tf_timeout,
+                         kFrameKey, &sample, &why)) {
       rejected_pairs_.fetch_add(1, std::memory_order_relaxed);
       pair_guard_.reject(Rejection::kContent, "the target's odometry: " + why);
       logRejection(pair_guard_, name_);

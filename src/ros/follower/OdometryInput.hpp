@@ -25,13 +25,15 @@ namespace projection_collision_avoidance {
 /// The follower's `odometry` input (~input odometry; doc/vehicles.md): subscribes its own
 /// `odom` and its target's `target_odom` (nav_msgs/Odometry, REP 105: pose in header.frame_id,
 /// twist in child_frame_id), judges each on its InputTimeline, brings both into one world frame
-/// (~measurement_frame, else the own odometry's header.frame_id) with tf2 when a frame differs,
-/// and, at every accepted own odometry, turns it and the target's latest into the relative state
-/// x_target − x_self of the controlled points (RelativeStateFromOdometry: the older sample moved
-/// to the newer stamp at constant velocity, a skew beyond ~odometry/max_skew refused; the points
-/// ~odometry/look_ahead and ~odometry/target_look_ahead ahead of each origin along its body x
-/// axis). The result goes to @p sink as a RelativeMeasurement stamped with the newer stamp, in
-/// the world frame, to be judged like any measurement. Nothing a message carries ends the node.
+/// (~measurement_frame, else the own odometry's header.frame_id) with tf2 when a frame differs
+/// (with ~odometry/pose_frame world: taken in ~measurement_frame as they are; with header, one
+/// whose header.frame_id is its child_frame_id is refused), and, at every accepted own odometry,
+/// turns it and the target's latest into the relative state x_target − x_self of the controlled
+/// points (RelativeStateFromOdometry: the older sample moved to the newer stamp at constant
+/// velocity, a skew beyond ~odometry/max_skew refused; the points ~odometry/look_ahead and
+/// ~odometry/target_look_ahead ahead of each origin along its body x axis). The result goes to @p
+/// sink as a RelativeMeasurement stamped with the newer stamp, in the world frame, to be judged
+/// like any measurement. Nothing a message carries ends the node.
 class OdometryInput : public MeasurementAdapter {
  public:
   /// @param axes of the model (2 or 3)
