@@ -9,8 +9,8 @@ namespace projection_collision_avoidance {
 namespace {
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
-/// Changes that asked for an acceleration before the realised fraction is given.
-constexpr int kMinExcitedChanges = 10;
+/// Segments that asked for an acceleration before the realised fraction is given.
+constexpr int kMinExcitedSegments = 5;
 /// Another delay is taken only when its error is below this fraction of the current one's.
 constexpr double kSwitchRatio = 0.8;
 
@@ -38,6 +38,10 @@ VehicleResponseEstimator::VehicleResponseEstimator(const ResponseEstimatorOption
         "vehicle.velocity.min_acceleration",
         "must be finite and >= 0 m/s², got " + std::to_string(options.min_acceleration));
   }
+  if (!(options.segment > 0.0) || !std::isfinite(options.segment)) {
+    throw ParameterError("vehicle.velocity.segment",
+                         "must be finite and > 0 s, got " + std::to_string(options.segment));
+  }
   candidates_ = static_cast<int>(std::floor(options.max_delay / options.period + 1e-9)) + 1;
   reset();
 }
@@ -50,7 +54,38 @@ void VehicleResponseEstimator::reset() {
   cross_ = 0.0;
   commanded_ = 0.0;
   excited_ = 0;
+  segment_velocity_.resize(0);
+  segment_time_ = 0.0;
   response_ = VehicleResponse();
+}
+
+void VehicleResponseEstimator::noteSegment(const AxisVector& velocity, double changed_at,
+                                           const CommandHistory& history) {
+  if (segment_velocity_.size() != velocity.size()) {
+    segment_velocity_ = velocity;
+    segment_time_ = changed_at;
+    return;
+  }
+  const double dt = changed_at - segment_time_;
+  if (dt < options_.segment) {
+    return;
+  }
+  const double delay = response_.delay;
+  const AxisVector commanded = history.incrementBetween(segment_time_ - delay, changed_at - delay);
+  // Only segments whose commands asked for an acceleration: at rest or cruising, the noise of
+  // Δv would make the ratio.
+  if (commanded.norm() >= options_.min_acceleration * dt) {
+    const double weight = -std::expm1(-dt / options_.averaging_time);
+    const AxisVector realised = velocity - segment_velocity_;
+    cross_ += weight * (realised.dot(commanded) - cross_);
+    commanded_ += weight * (commanded.squaredNorm() - commanded_);
+    ++excited_;
+  }
+  response_.realised_fraction = excited_ >= kMinExcitedSegments && commanded_ > 0.0
+                                    ? cross_ / commanded_
+                                    : std::numeric_limits<double>::quiet_NaN();
+  segment_velocity_ = velocity;
+  segment_time_ = changed_at;
 }
 
 void VehicleResponseEstimator::observe(const AxisVector& velocity, double changed_at,
@@ -94,22 +129,7 @@ void VehicleResponseEstimator::observe(const AxisVector& velocity, double change
     chosen_ = best;
   }
   response_.delay = chosen_ * options_.period;
-  if (previous_.size() == velocity.size()) {
-    const AxisVector commanded =
-        history.incrementBetween(previous_time_ - response_.delay, changed_at - response_.delay);
-    // Only changes that asked for an acceleration: at rest or cruising, the noise of Δv would
-    // make the ratio.
-    const double dt = changed_at - previous_time_;
-    if (commanded.norm() >= options_.min_acceleration * dt) {
-      const AxisVector realised = velocity - previous_;
-      cross_ += weight * (realised.dot(commanded) - cross_);
-      commanded_ += weight * (commanded.squaredNorm() - commanded_);
-      ++excited_;
-    }
-    response_.realised_fraction = excited_ >= kMinExcitedChanges && commanded_ > 0.0
-                                      ? cross_ / commanded_
-                                      : std::numeric_limits<double>::quiet_NaN();
-  }
+  noteSegment(velocity, changed_at, history);
   previous_ = velocity;
   previous_time_ = changed_at;
   ++response_.observations;

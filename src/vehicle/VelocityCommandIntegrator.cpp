@@ -28,10 +28,13 @@ ResponseEstimatorOptions estimatorOptions(const VelocityIntegratorOptions& optio
   return estimator;
 }
 
-/// Commands kept: a delay and a hold, each up to max_delay (validated by the estimator first).
+/// Commands kept: a delay and a hold, each up to max_delay, and the estimator's segment
+/// (validated by the estimator first).
 std::size_t historyCapacity(const VelocityIntegratorOptions& options) {
   const VehicleResponseEstimator check(estimatorOptions(options));
-  return 2 * static_cast<std::size_t>(check.candidates()) + 2;
+  const double segment = check.options().segment / options.period;
+  return 2 * static_cast<std::size_t>(check.candidates()) + 2 +
+         static_cast<std::size_t>(std::ceil(std::min(segment, 1e4)));
 }
 
 int checkedAxes(int axes) {
@@ -103,8 +106,10 @@ const VelocityCommand& VelocityCommandIntegrator::step(const AxisVector& acceler
   }
   AxisVector anchor = command_.velocity;
   if (fresh) {  // the measurement and the commands sent since the state it shows
-    anchor = measured_ + history_.incrementBetween(measured_changed_at_ - delay(),
-                                                   std::numeric_limits<double>::infinity());
+    // At most 2 max_delay + 2 T of commands: a vehicle that cannot follow winds up no further.
+    const double from = std::max(measured_changed_at_ - delay(),
+                                 now - 2.0 * (options_.max_delay + options_.period));
+    anchor = measured_ + history_.incrementBetween(from, std::numeric_limits<double>::infinity());
   }
   if (!anchor.allFinite()) {  // increments that overflow: start from the measurement alone
     anchor = measured_;

@@ -601,6 +601,13 @@ NODE_OPTIONS = [
          options={"odometry": {"pose_frame": "world"}}, nodes=(ADAPTER,)),
     case("adapter odometry twist_frame unknown", "~odometry/twist_frame",
          options={"odometry": {"twist_frame": "world"}}, nodes=(ADAPTER,)),
+    # command_adapter: the vehicle's response delay
+    case("adapter velocity delay past max_delay", "~velocity/delay",
+         options={"velocity": {"delay": 0.5, "max_delay": 0.3}}, nodes=(ADAPTER,)),
+    case("adapter velocity max_delay past 255 periods", "~velocity/max_delay",
+         options={"velocity": {"max_delay": 3.0}}, nodes=(ADAPTER,)),
+    case("adapter velocity averaging_time zero", "~velocity/averaging_time",
+         options={"velocity": {"averaging_time": 0.0}}, nodes=(ADAPTER,)),
     on_input("tf without a world frame", "measurement_frame", "tf",
              **{"tf/self_frame": "follower", "tf/target_frame": "leader"}),
     on_input("tf without its own frame", "tf/self_frame", "tf", measurement_frame="world",

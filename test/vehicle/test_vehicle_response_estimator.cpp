@@ -84,6 +84,9 @@ TEST(VehicleResponseEstimator, RefusesUnusableOptions) {
   o = ResponseEstimatorOptions();
   o.min_acceleration = -0.01;
   EXPECT_EQ(refusedKey(o), "vehicle.velocity.min_acceleration");
+  o = ResponseEstimatorOptions();
+  o.segment = 0.0;
+  EXPECT_EQ(refusedKey(o), "vehicle.velocity.segment");
 }
 
 TEST(VehicleResponseEstimator, FindsTheHoldAndTheDelayOfAVehicleSlowerThanItsCommands) {
