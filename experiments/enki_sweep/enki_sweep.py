@@ -20,6 +20,8 @@ Writes a CSV and a markdown table. Usage (run.sh beside it sources the workspace
   enki_sweep.py [--cases quick|full] [--vehicles thymio2 epuck] [--inputs odometry tf position]
                 [--steps 0.01 0.05 0.1] [--headings 0 90 180] [--pushes 1 2] [--duration S]
                 [--csv FILE] [--md FILE] [--port P] [--keep DIR]
+  enki_sweep.py --from-csv FILE [--md FILE]   (the tables again from a CSV, running nothing)
+The markdown file has a summary per vehicle x input x step, then every case.
 """
 
 import argparse
@@ -231,6 +233,60 @@ def markdown(rows):
     return "\n".join(lines) + "\n"
 
 
+def summary(rows):
+    """Per vehicle x input x physics step, over headings and pushes: the worst case of each."""
+    head = ("| vehicle | input | step (s) | cases ok | max ‖ξ‖ (m) | ξ_max (m) "
+            "| min controlled points (m) | min centres (m) | perimeter (m) "
+            "| a_real/a_cmd median (min–max) | adapter delay (s) |")
+    lines = [head, "|" + "---|" * (head.count("|") - 1)]
+    groups = {}
+    for r in rows:
+        groups.setdefault((r["vehicle"], r["input"], float(r["physics_step"])), []).append(r)
+
+    def values(group, key):
+        out = [float(r[key]) for r in group if r.get(key) not in (None, "")]
+        return [v for v in out if not math.isnan(v)]
+
+    for (vehicle, input_, step), group in sorted(groups.items()):
+        ratios = sorted(values(group, "accel_ratio"))
+        delays = values(group, "adapter_delay")
+        median = ratios[len(ratios) // 2] if len(ratios) % 2 else \
+            0.5 * (ratios[len(ratios) // 2 - 1] + ratios[len(ratios) // 2]) if ratios else math.nan
+        lines.append("| " + " | ".join([
+            vehicle, input_, fmt(step, 2),
+            f"{sum(1 for r in group if r['result'] == 'ok')}/{len(group)}",
+            fmt(max(values(group, "max_xi"), default=math.nan)),
+            fmt(max(values(group, "xi_max"), default=math.nan)),
+            fmt(min(values(group, "min_controlled"), default=math.nan)),
+            fmt(min(values(group, "min_centres"), default=math.nan)),
+            fmt(max(values(group, "perimeter"), default=math.nan)),
+            f"{fmt(median, 2)} ({fmt(ratios[0], 2)}–{fmt(ratios[-1], 2)})" if ratios else "",
+            f"{fmt(min(delays), 2)}–{fmt(max(delays), 2)}" if delays else ""]) + " |")
+    return "\n".join(lines) + "\n"
+
+
+def write_markdown(path, rows, note):
+    with open(path, "w") as out:
+        out.write(f"<!-- {note} -->\n" + summary(rows) + "\n" + markdown(rows))
+
+
+COUNTS = ("statuses", "tracking", "fallback_steps", "rejected", "accel_windows")
+
+
+def from_csv(path):
+    """The rows of a CSV this script wrote, numbers as floats."""
+    rows = []
+    with open(path, newline="") as f:
+        for row in csv.DictReader(f):
+            for key in FIELDS[5:-1]:
+                if row.get(key) not in (None, "") and key != "recorded_from":
+                    number = float(row[key])
+                    row[key] = int(number) if key in COUNTS else number
+            row["physics_step"] = float(row["physics_step"])
+            rows.append(row)
+    return rows
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--cases", choices=("quick", "full"), default="quick")
@@ -246,8 +302,15 @@ def main():
     parser.add_argument("--md", default=str(ROOT / "doc" / "vehicles_enki.md"))
     parser.add_argument("--port", type=int, default=11431)
     parser.add_argument("--keep", help="directory for the bags and logs (default: a temporary one)")
+    parser.add_argument("--from-csv", metavar="CSV",
+                        help="run nothing: write --md again from a CSV this script wrote")
     args = parser.parse_args()
 
+    if args.from_csv:
+        rows = from_csv(args.from_csv)
+        write_markdown(args.md, rows, f"experiments/enki_sweep/run.sh: {len(rows)} cases "
+                                      f"(from {pathlib.Path(args.from_csv).name})")
+        return 0
     if args.cases == "quick":
         cases = QUICK
     else:
@@ -269,11 +332,9 @@ def main():
             for row in rows:
                 writer.writerow({k: fmt(row.get(k), 4) if isinstance(row.get(k), float)
                                  else row.get(k, "") for k in FIELDS})
-        table = markdown(rows)
-        with open(args.md, "w") as out:
-            out.write(f"<!-- experiments/enki_sweep/run.sh --cases {args.cases}: {len(rows)} "
-                      f"cases, {args.duration:g} s each -->\n" + table)
-        print(table, end="")
+        write_markdown(args.md, rows, f"experiments/enki_sweep/run.sh --cases {args.cases}: "
+                                      f"{len(rows)} cases, {args.duration:g} s each")
+        print(summary(rows), end="")
     return 0 if all(r["result"] == "ok" for r in rows) else 1
 
 
