@@ -1,5 +1,6 @@
 /// rostest: what the follower publishes (status, markers, tf frames of the plant, diagnostics)
-/// and its dynamic_reconfigure interface, on the paper's Run 2. Parameters of the test node:
+/// the frame of its command, and its dynamic_reconfigure interface, on the paper's Run 2.
+/// Parameters of the test node:
 ///   ~wall_deadline  wall seconds to wait for each condition
 
 #include <cmath>
@@ -8,6 +9,7 @@
 #include <string>
 
 #include <dynamic_reconfigure/Reconfigure.h>
+#include <geometry_msgs/AccelStamped.h>
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 #include <tf2_ros/buffer.h>
@@ -75,6 +77,21 @@ TEST_F(FollowerTest, PublishesStatusWithTheScenariosBounds) {
   EXPECT_FALSE(s.command_rate_limited);
   EXPECT_TRUE(std::isinf(s.jerk_limit));
   EXPECT_NEAR(s.distance, 5.0, 0.05);  // before the disturbance the follower holds its slot
+}
+
+TEST_F(FollowerTest, NamesTheMeasurementsFrameInTheCommand) {
+  // The plant's relative measurements are in its world frame ("world"), and so is u_2: the
+  // command says so (~follower_frame, "follower", names only the status and the markers).
+  std::string frame;
+  ros::Subscriber subscriber = nh_.subscribe<geometry_msgs::AccelStamped>(
+      "/follower/command", 10, [&](const geometry_msgs::AccelStamped::ConstPtr& msg) {
+        const std::lock_guard<std::mutex> lock(mutex_);
+        frame = msg->header.frame_id;
+      });
+  ASSERT_TRUE(waitFor([&] { return !frame.empty(); }, param("wall_deadline")))
+      << "no command from the follower";
+  const std::lock_guard<std::mutex> lock(mutex_);
+  EXPECT_EQ(frame, "world");
 }
 
 TEST_F(FollowerTest, PublishesMarkersInTheFollowerFrame) {

@@ -20,15 +20,16 @@
 namespace projection_collision_avoidance {
 
 struct CommandAdapterOptions;
+class CommandFrame;
 
 /// The follower's command for a vehicle stack (node `command_adapter`, nodelet
 /// CommandAdapterNodelet; doc/vehicles.md). Subscribes `command` (geometry_msgs/AccelStamped:
-/// the follower's acceleration, world frame) and the vehicle's own `odom` (nav_msgs/Odometry:
-/// heading and measured velocity, twist in child_frame_id as REP 105 says; moved into
-/// ~world_frame with tf2 when that is set and its frame differs) and publishes, for
-/// each command, the ~outputs chosen: `setpoint_accel` (geometry_msgs/Vector3Stamped, the
-/// acceleration in the world frame: the follower's command is in the axes of its measurements,
-/// whatever its frame_id, ENU as MAVROS's setpoint_accel plugin takes it),
+/// the follower's acceleration in the axes of its frame_id, turned into the world frame by tf2
+/// when it names another frame than the world and the base frame: CommandFrame) and the vehicle's
+/// own `odom` (nav_msgs/Odometry: heading and measured velocity, twist in child_frame_id as REP 105
+/// says; moved into ~world_frame with tf2 when that is set and its frame differs) and publishes,
+/// for each command, the ~outputs chosen: `setpoint_accel` (geometry_msgs/Vector3Stamped, the
+/// acceleration in the world frame, ENU as MAVROS's setpoint_accel plugin takes it),
 /// `cmd_vel` (geometry_msgs/Twist: the velocity command, world or base frame, or a unicycle's
 /// v and ω) and `cmd_vel_stamped` (geometry_msgs/TwistStamped). CommandConverter makes them.
 ///
@@ -68,6 +69,7 @@ class CommandAdapter {
   std::string base_frame_;   ///< ~base_frame, or the own odometry's child_frame_id
   Eigen::VectorXd acceleration_;
   bool warned_no_base_frame_ = false;
+  std::unique_ptr<CommandFrame> command_frame_;  ///< the command's frame into world_frame_
   /// `/diagnostics` at 1 Hz of ROS time, from the watchdog's timer: accepted, rejected and
   /// superseded messages of `command` and `odom`.
   diagnostic_updater::Updater diagnostics_;

@@ -13,6 +13,7 @@
 #include "projection_collision_avoidance/ros/RosParameters.hpp"
 
 #include "adapter/CommandAdapterOptions.hpp"
+#include "adapter/CommandFrame.hpp"
 
 namespace projection_collision_avoidance {
 namespace {
@@ -65,6 +66,8 @@ CommandAdapter::CommandAdapter(ros::NodeHandle nh, ros::NodeHandle private_nh)
     twist_stamped_publisher_ = nh.advertise<geometry_msgs::TwistStamped>("cmd_vel_stamped", 10);
   }
   tf_listener_ = std::make_unique<tf2_ros::TransformListener>(tf_buffer_, nh);
+  command_frame_ =
+      std::make_unique<CommandFrame>(name_, &tf_buffer_, options_->world_frame.empty());
   odometry_subscriber_ = nh.subscribe("odom", 10, &CommandAdapter::onOdometry, this,
                                       ros::TransportHints().tcpNoDelay());
   command_subscriber_ = nh.subscribe("command", 10, &CommandAdapter::onCommand, this,
@@ -140,6 +143,9 @@ void CommandAdapter::onCommand(const geometry_msgs::AccelStamped::ConstPtr& msg)
       return;
     }
     command_timeline_.accept();
+    // In the follower's world frame, which its frame_id names: into this node's world frame.
+    command_frame_->toWorld(msg->header.frame_id, world_frame_, base_frame_, steadySeconds(),
+                            &acceleration_);
     const ConvertedCommand& command = converter_.convert(acceleration_, now.toSec());
     if (!command.heading_known) {
       ROS_WARN_STREAM_THROTTLE(5.0, name_ << ": no fresh own odometry (odom) for the heading: "
@@ -177,6 +183,10 @@ void CommandAdapter::diagnose(diagnostic_updater::DiagnosticStatusWrapper& statu
   if (!odometry_rejection.empty()) {
     status.mergeSummary(DiagnosticStatus::WARN, "rejecting odometry: " + odometry_rejection);
   }
+  if (!command_frame_->warning().empty()) {
+    status.mergeSummary(DiagnosticStatus::WARN, command_frame_->warning());
+  }
+  status.add("command_turned_by_tf", command_frame_->turned());
   status.add("accepted_commands", command_timeline_.guard().accepted());
   status.add("rejected_commands", command_timeline_.rejected());
   status.add("accepted_odometry", odometry_timeline_.guard().accepted());

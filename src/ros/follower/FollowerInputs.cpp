@@ -79,6 +79,15 @@ FollowerInputStats FollowerInputs::stats(std::int64_t now_ns) const {
   return stats;
 }
 
+void FollowerInputs::commandFrame(std::string* frame) const {
+  if (!options_.measurement_frame.empty()) {  // every accepted measurement carries it
+    *frame = options_.measurement_frame;
+    return;
+  }
+  const std::lock_guard<std::mutex> lock(reasons_mutex_);
+  *frame = command_frame_;
+}
+
 void FollowerInputs::onMeasurement(const RelativeMeasurement::ConstPtr& msg) {
   admitMeasurement(*msg);
 }
@@ -114,6 +123,12 @@ void FollowerInputs::admitMeasurement(const RelativeMeasurement& measurement) {
     measurement_.sequence = guard.accepted();
     measurement_.relative_state = relative_state_;
     cycle_->measurement().write(measurement_);
+    // The command is in this measurement's axes: its frame names the command's (commandFrame()).
+    if (tfFrameName(msg->header.frame_id) != accepted_frame_) {  // only this thread writes it
+      accepted_frame_.assign(tfFrameName(msg->header.frame_id));
+      const std::lock_guard<std::mutex> lock(reasons_mutex_);
+      command_frame_ = accepted_frame_;
+    }
     if (on_accepted_) {
       on_accepted_(skipped);
     }

@@ -90,6 +90,12 @@ class FollowerInputs {
   /// Refusal counts, latest reasons and the inputs' ages at ROS time @p now_ns (any thread).
   FollowerInputStats stats(std::int64_t now_ns) const;
 
+  /// The frame the command is expressed in, into @p frame (any thread; no allocation once
+  /// @p frame holds a name that long): ~measurement_frame when set, else the frame_id of the
+  /// latest accepted measurement (the world frame the input adapter moved it into, or the one
+  /// the relative measurement was sent in), else "" (no world frame known).
+  void commandFrame(std::string* frame) const;
+
  private:
   void onMeasurement(const RelativeMeasurement::ConstPtr& msg);
   void onLeaderBroadcast(const LeaderBroadcast::ConstPtr& msg);
@@ -113,6 +119,7 @@ class FollowerInputs {
   OwnStateSample own_state_;
   Eigen::VectorXd odometry_state_;
   PlanarOrSpatialState origin_state_;  ///< the own odometry's [p; v] before it is accepted
+  std::string accepted_frame_;  ///< the latest accepted measurement's frame_id (tfFrameName())
 
   // Read by other threads.
   std::atomic<const MeasurementAdapter*> adapter_{nullptr};
@@ -120,6 +127,7 @@ class FollowerInputs {
   mutable std::mutex reasons_mutex_;
   std::string measurement_rejection_;
   std::string leader_rejection_;
+  std::string command_frame_;  ///< accepted_frame_, for commandFrame() (reasons_mutex_)
 
   /// The subscriptions' callbacks run at once on roscpp's network thread (no spinner hand-off).
   InlineCallbackQueue inline_queue_;

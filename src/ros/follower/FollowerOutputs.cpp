@@ -75,9 +75,12 @@ void FollowerOutputs::publish(const FollowerCycleOutput& out) {
   if (out.stepped) {
     const ros::Time stamp = rosTimeOf(out.stamp_ns);
     // Published as shared pointers: a subscriber in the same process (a nodelet) gets the
-    // message itself, neither serialised nor copied.
+    // message itself, neither serialised nor copied. Its frame_id is the world frame the
+    // command is expressed in (that of the measurements), else, none known, the follower's.
+    inputs_->commandFrame(&command_frame_);
     command_publisher_.publish(boost::make_shared<geometry_msgs::AccelStamped>(
-        toAccelMsg(out.status.command, stamp, options_.follower_frame)));
+        toAccelMsg(out.status.command, stamp,
+                   command_frame_.empty() ? options_.follower_frame : command_frame_)));
     // The other messages are made only while someone subscribes to them.
     if (broadcast_publisher_.subscribed()) {
       auto broadcast = boost::make_shared<LeaderBroadcast>();  // its acceleration, no state

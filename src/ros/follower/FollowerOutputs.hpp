@@ -22,9 +22,11 @@
 namespace projection_collision_avoidance {
 
 /// The follower's outputs: from each FollowerCycleOutput it publishes `command`
-/// (AccelStamped), `broadcast` (its command as a LeaderBroadcast, for a follower behind it),
-/// `status` (FollowerStatus) and, every so many steps, `markers`; it updates the diagnostics and
-/// writes the log lines the cycle's events call for (mode changes, time jumps, stalls).
+/// (AccelStamped; frame_id the world frame of the measurements, FollowerInputs::commandFrame(),
+/// or ~follower_frame when none is known), `broadcast` (its command as a LeaderBroadcast, for a
+/// follower behind it), `status` (FollowerStatus) and, every so many steps, `markers`; it updates
+/// the diagnostics and writes the log lines the cycle's events call for (mode changes, time jumps,
+/// stalls).
 ///
 /// publish() does it on the calling thread (timer loop, measurement trigger; one call at a time).
 /// post() is for a
@@ -81,6 +83,7 @@ class FollowerOutputs {
   std::uint64_t steps_per_status_ = 0;                 ///< 0: no status
   FollowerMode status_mode_ = FollowerMode::kWaiting;  ///< the mode of the latest status
   MarkerOrigin marker_origin_;
+  std::string command_frame_;  ///< the command's frame (FollowerInputs::commandFrame()), "": none
 
   std::mutex publish_mutex_;    ///< publish(): the timer's or outputs' thread vs a measurement's
   FollowerCycleOutput latest_;  ///< the latest step, with the counters of the latest output

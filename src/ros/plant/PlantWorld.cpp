@@ -17,6 +17,7 @@
 
 #include "projection_collision_avoidance/core/Formation.hpp"
 #include "projection_collision_avoidance/core/ParameterError.hpp"
+#include "projection_collision_avoidance/cycle/FrameNames.hpp"
 #include "projection_collision_avoidance/ros/MessageConversions.hpp"
 #include "projection_collision_avoidance/ros/ScenarioParameters.hpp"
 
@@ -43,8 +44,9 @@ PlantWorld::Agent::Agent(const std::string& agent_name, const std::string& tf_fr
       // A command stamped ahead of the plant's time by more than the command timeout would never
       // time out: its sender's clock is not the plant's (a wall-time stamp under simulated
       // time, say). Jumps back of the plant's time come from its clock (PlantClock's hook).
+      // The frame is judged in onCommand(): the agent's or the world's.
       command_timeline(agent_name + "/command",
-                       {{tf_frame, command_timeout, command_timeout}, clock_skew, false}) {}
+                       {{"", command_timeout, command_timeout}, clock_skew, false}) {}
 
 PlantWorld::PlantWorld(ros::NodeHandle nh, ros::NodeHandle private_nh)
     : nh_(nh),
@@ -255,6 +257,16 @@ void PlantWorld::onCommand(Agent* agent, const geometry_msgs::AccelStamped::Cons
   const std::lock_guard<std::mutex> lock(mutex_);
   InputTimeline& timeline = agent->command_timeline;
   admitGuarded(timeline, name_, [&] {
+    // In the world frame (a follower names the frame of its measurements, the plant's world) or
+    // the agent's (a leader, or a follower that knows no world frame): the same axes here.
+    if (!sameFrame(msg->header.frame_id, agent->frame) &&
+        !sameFrame(msg->header.frame_id, options_.world_frame)) {
+      timeline.reject(Rejection::kFrame,
+                      "frame_id '" +
+                          boundedText(msg->header.frame_id, InputGuard::kMaxQuotedLength) +
+                          "', expected '" + agent->frame + "' or '" + options_.world_frame + "'");
+      return;
+    }
     // Judged on the sender's clock, its order on the raw stamps and its age against the plant's
     // time moved by the offset of ~clock_skew/policy (0 by default), as the follower does.
     if (!checkHeader(timeline, msg->header, plantNow())) {

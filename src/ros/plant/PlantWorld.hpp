@@ -36,7 +36,8 @@ namespace projection_collision_avoidance {
 ///
 /// Subscribes `leader/command` and `<follower>/command` (geometry_msgs/AccelStamped; each held
 /// until replaced, and taken as zero once older than command_timeout; a command that is
-/// non-finite, acts on an axis the model lacks, is not in the agent's frame, is stamped more
+/// non-finite, acts on an axis the model lacks, is in neither the agent's frame nor the world
+/// frame, is stamped more
 /// than command_timeout ahead of the plant's time or before the last accepted one is rejected,
 /// counted and warned about once per kind). At each tick t_k = k / rate it publishes
 /// `leader/odom`, `<follower>/odom` (nav_msgs/Odometry), tf world -> each agent's frame,
@@ -74,7 +75,7 @@ class PlantWorld {
           double command_timeout, const StampCorrectionOptions& clock_skew);
 
     std::string name;   ///< topic prefix: "leader", "follower"
-    std::string frame;  ///< tf frame; commands must carry it as frame_id
+    std::string frame;  ///< tf frame; commands carry it or the world frame as frame_id
     AgentIntegrator<GenericDimensions> integrator;
     Eigen::VectorXd command;  ///< latest accepted command (m/s^2)
     /// The commands' timeline: judged on the sender's clock, their stamps put on the plant's
