@@ -188,7 +188,7 @@ def run_case(case, args, work):
     cmd = ["roslaunch", "--port", str(args.port), str(LAUNCH), f"vehicle:={vehicle}",
            f"input:={input_}", f"physics_step:={step}", f"heading_deg:={heading}",
            f"push_scale:={push}", f"duration:={args.duration}", f"look_ahead:={args.look_ahead}",
-           f"bag:={bag}"]
+           f"adapter_world_frame:={args.adapter_world_frame}", f"bag:={bag}"]
     start = time.monotonic()
     with open(work / f"{name}.log", "w") as log:
         proc = subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT, env=env)
@@ -300,6 +300,9 @@ def main():
     parser.add_argument("--window", type=float, default=0.2, help="s of each a_real [0.2]")
     parser.add_argument("--csv", default=str(ROOT / "doc" / "vehicles_enki.csv"))
     parser.add_argument("--md", default=str(ROOT / "doc" / "vehicles_enki.md"))
+    parser.add_argument("--adapter-world-frame", default="world",
+                        help="the adapter's ~world_frame; '' leaves it to the odometry's frame "
+                             "(commands turned by tf) [world]")
     parser.add_argument("--port", type=int, default=11431)
     parser.add_argument("--keep", help="directory for the bags and logs (default: a temporary one)")
     parser.add_argument("--from-csv", metavar="CSV",

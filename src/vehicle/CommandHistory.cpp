@@ -40,12 +40,12 @@ void CommandHistory::push(double time, const AxisVector& velocity, const AxisVec
   ring_[slot].increment = increment;
 }
 
-void CommandHistory::replaceNewest(const AxisVector& velocity) {
-  if (size_ == 0 || velocity.size() != axes_ || !velocity.allFinite()) {
+void CommandHistory::replaceNewest(const AxisVector& velocity, double scale) {
+  if (size_ == 0 || velocity.size() != axes_ || !velocity.allFinite() || !std::isfinite(scale)) {
     return;
   }
   SentCommand& newest = ring_[(head_ + size_ - 1) % ring_.size()];
-  newest.increment += velocity - newest.velocity;
+  newest.increment += (velocity - newest.velocity) * scale;
   newest.velocity = velocity;
 }
 

@@ -119,8 +119,12 @@ const VelocityCommand& VelocityCommandIntegrator::step(const AxisVector& acceler
   command_.limited = false;
   command_.refused = acceleration.size() != options_.axes || !acceleration.allFinite() ||
                      !(period > 0.0) || !std::isfinite(period);
+  // The history keeps what each command asks of the vehicle over a period, a T: its increment
+  // over the anchor, a h, times T / h (for a lagging vehicle h > T).
+  increment_scale_ = 1.0;
   if (!command_.refused) {
     const double lead = fresh ? velocityLead(period, options_.velocity_lag) : period;
+    increment_scale_ = period / lead;
     const AxisVector next = anchor + acceleration * lead;
     if (next.allFinite()) {
       anchor = next;
@@ -129,7 +133,7 @@ const VelocityCommand& VelocityCommandIntegrator::step(const AxisVector& acceler
     }
   }
   command_.limited = clampNorm(anchor, options_.max_speed) > 0.0;
-  history_.push(now, anchor, anchor - base);
+  history_.push(now, anchor, (anchor - base) * increment_scale_);
   command_.velocity = anchor;
   return command_;
 }
@@ -137,7 +141,7 @@ const VelocityCommand& VelocityCommandIntegrator::step(const AxisVector& acceler
 void VelocityCommandIntegrator::setSent(const AxisVector& velocity) {
   if (velocity.size() == options_.axes && velocity.allFinite()) {
     command_.velocity = velocity;
-    history_.replaceNewest(velocity);
+    history_.replaceNewest(velocity, increment_scale_);
   }
 }
 

@@ -169,6 +169,31 @@ TEST(VelocityCommandIntegrator, LeadMakesALaggingVehicleGainATPerPeriod) {
   }
 }
 
+/// The lagging vehicle measured a period late (its odometry arrives after the command of its
+/// own instant): the command of that period, not shown yet, is added as what it asks of the
+/// vehicle, a T, not as its lead a h, and the vehicle still gains a T per period.
+TEST(VelocityCommandIntegrator, ALaggingVehicleMeasuredAPeriodLateGainsATPerPeriod) {
+  const double T = 0.01;
+  const double tau = 0.1;
+  const double decay = std::exp(-T / tau);
+  VelocityCommandIntegrator integrator(options(1, kInf, 0.05, tau));
+  double v = 0.3;
+  double v_before = 0.3;  // the velocity a period ago: what the measurement shows
+  double gained = 0.0;
+  double largest_gain = 0.0;
+  for (int k = 1; k < 200; ++k) {
+    ASSERT_TRUE(integrator.measure(vec(v_before), (k - 1) * T));
+    const double command = integrator.step(vec(1.5), T, k * T).velocity(0);
+    const double next = command + (v - command) * decay;
+    gained = next - v;
+    largest_gain = std::max(largest_gain, gained);
+    v_before = v;
+    v = next;
+  }
+  EXPECT_NEAR(gained, 1.5 * T, 1e-9);      // the acceleration asked for
+  EXPECT_LE(largest_gain, 1.5 * T * 1.5);  // no overshoot from counting the lead as a gain
+}
+
 TEST(VelocityCommandIntegrator, SpeedLimitKeepsTheDirection) {
   VelocityCommandIntegrator integrator(options(2, 1.5));
   ASSERT_TRUE(integrator.measure(vec(1.0, 1.0), 0.0));

@@ -13,9 +13,11 @@ namespace projection_collision_avoidance {
 
 /// One velocity command as sent.
 struct SentCommand {
-  double time = 0.0;     ///< s, when it was sent
-  AxisVector velocity;   ///< m/s, the command
-  AxisVector increment;  ///< m/s, what it added to its anchor (a h when nothing limited it)
+  double time = 0.0;    ///< s, when it was sent
+  AxisVector velocity;  ///< m/s, the command
+  /// m/s, the velocity change it asks of the vehicle over a period: a T when nothing limited it
+  /// (what it added to its anchor, a h, times T / h)
+  AxisVector increment;
 };
 
 /// The last `capacity` velocity commands, oldest first, in a ring allocated once: push(),
@@ -32,8 +34,9 @@ class CommandHistory {
   void push(double time, const AxisVector& velocity, const AxisVector& increment);
 
   /// Replaces the newest command by what was actually sent (@p velocity), its increment
-  /// changed by the same amount. Ignored when empty, not finite or of the wrong size.
-  void replaceNewest(const AxisVector& velocity);
+  /// changed by @p scale times as much (T / h). Ignored when empty, not finite or of the wrong
+  /// size.
+  void replaceNewest(const AxisVector& velocity, double scale = 1.0);
 
   /// The command in force just before @p time (s): the last one sent before it. (A velocity
   /// measured at t shows at most the commands sent before t: one sent at t was made after it.)

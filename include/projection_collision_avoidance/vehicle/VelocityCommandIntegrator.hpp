@@ -61,8 +61,9 @@ double velocityLead(double period, double velocity_lag);
 
 /// v_cmd(k+1) = clamp(v_anchor + a h, max_speed):
 /// - anchor = the measured velocity v_m when fresh, brought up to date with the commands it does
-///   not show yet: v_anchor = v_m + Σ Δc_j over the commands sent after t_m − D (t_m: when the
-///   measured state changed last, D: the response delay), h = velocityLead(T, τ). The command is
+///   not show yet: v_anchor = v_m + Σ Δc_j over the commands sent at or after t_m − D (t_m: when
+///   the measured state changed last, D: the response delay; Δc_j = a_j T, what command j asks
+///   of the vehicle over a period, less when a limit acted), h = velocityLead(T, τ). The command is
 ///   a fixed lead ahead of what the vehicle will do, so when the vehicle's own controller
 ///   saturates (it cannot follow) the command stays within the increments of the last
 ///   2 max_delay of v_measured instead of growing: no wind-up beyond that bound.
@@ -113,6 +114,7 @@ class VelocityCommandIntegrator {
   double measured_stamp_ = 0.0;
   double measured_changed_at_ = 0.0;
   bool have_measurement_ = false;
+  double increment_scale_ = 1.0;  ///< T / h of the last step
   VelocityCommand command_;
 };
 
