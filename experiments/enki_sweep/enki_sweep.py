@@ -301,7 +301,7 @@ def main():
     parser.add_argument("--csv", default=str(ROOT / "doc" / "vehicles_enki.csv"))
     parser.add_argument("--md", default=str(ROOT / "doc" / "vehicles_enki.md"))
     parser.add_argument("--adapter-world-frame", default="world",
-                        help="the adapter's ~world_frame; '' leaves it to the odometry's frame "
+                        help="the adapter's ~world_frame; none leaves it to the odometry's frame "
                              "(commands turned by tf) [world]")
     parser.add_argument("--port", type=int, default=11431)
     parser.add_argument("--keep", help="directory for the bags and logs (default: a temporary one)")
