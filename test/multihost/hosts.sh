@@ -46,13 +46,19 @@ source "$build/devel/setup.bash"
 source "$here/netns.sh"
 make_hosts "$followers"
 
+faketime_library=$(ls /usr/lib/*/faketime/libfaketime.so.1 2>/dev/null | head -n 1)
+[[ $clocks == *[1-9]* && -z $faketime_library ]] && { echo "hosts.sh: libfaketime not found" >&2; exit 2; }
 sim_time=sim_time:=true  # the tests' default; fleet_follower.launch's is false (a real fleet)
 for a in "$@"; do [[ $a == sim_time:=* ]] && sim_time=$a; done
 scenario_dir=$(rospack find projection_collision_avoidance)/config/scenarios
 for i in $(seq "$followers"); do
   offset=${offsets[$((i - 1))]:-}
   prefix=()
-  [[ -n $offset && $offset != 0 ]] && prefix=(faketime -f "$offset")
+  # libfaketime preloaded with a fixed offset, not through the faketime wrapper: the wrapper
+  # creates a semaphore and shared memory named by its process id in /dev/shm, which a wrapper
+  # killed before it cleaned up leaves behind for a later process of the same id to collide with
+  # ("sem_open: File exists", the follower never starts).
+  [[ -n $offset && $offset != 0 ]] && prefix=(env LD_PRELOAD="$faketime_library" FAKETIME="$offset")
   if [[ $kind == pair ]]; then
     launch=(pair.launch scenario:="$scenario_dir/paper_run2.yaml" world:=false control_rate:=100)
   else
