@@ -16,7 +16,6 @@ lagging clock beyond its ~max_future_stamp) and accepted at least ~min_commands.
 import math
 import sys
 import threading
-import time
 import unittest
 
 import rospy
@@ -25,6 +24,8 @@ from diagnostic_msgs.msg import DiagnosticArray
 from nav_msgs.msg import Odometry
 
 from projection_collision_avoidance.msg import FollowerStatus
+
+import ros_test_helpers as helpers
 
 
 class EnkiBurstyClock(unittest.TestCase):
@@ -70,13 +71,11 @@ class EnkiBurstyClock(unittest.TestCase):
                 self.travel = max(self.travel, math.hypot(p.x - sx, p.y - sy))
 
     def wait_for(self, condition, deadline, what):
-        end = time.monotonic() + deadline
-        while time.monotonic() < end and not rospy.is_shutdown():
+        """ros_test_helpers.wait_for with the condition read under the callbacks' lock."""
+        def locked():
             with self.lock:
-                if condition():
-                    return
-            time.sleep(0.05)
-        self.fail(what)
+                return bool(condition())
+        helpers.wait_for(self, locked, what, deadline)
 
     def test_follower_and_adapter_keep_up_with_a_bursty_clock(self):
         deadline = float(rospy.get_param("~wall_deadline"))
