@@ -42,6 +42,10 @@ const char* toString(Rejection kind) {
       return "content";
     case Rejection::kUnjudgeable:
       return "unjudgeable";
+    case Rejection::kPublisher:
+      return "other publisher";
+    case Rejection::kImplausible:
+      return "implausible stamp";
   }
   return "unknown";
 }

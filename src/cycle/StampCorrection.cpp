@@ -10,6 +10,9 @@ namespace {
 
 constexpr double kNanosecondsPerSecond = 1e9;
 constexpr double kMaxSeconds = 1e6;  // about 11 days: far beyond any window or offset
+/// 2^60 ns (36 years): |offsets| stay below it (skews of stamps in ros::Time's range are below
+/// 2^62), so the clamp's ends cannot overflow.
+constexpr std::int64_t kMaxNs = std::int64_t{1} << 60;
 
 std::int64_t floorDiv(std::int64_t a, std::int64_t b) {
   const std::int64_t q = a / b;
@@ -39,6 +42,11 @@ StampCorrection::StampCorrection(const StampCorrectionOptions& options) : option
     throw std::invalid_argument("max_offset must lie in [0, 1e6] s, got " +
                                 std::to_string(options.max_offset));
   }
+  if (!(options.max_drift_rate >= 0.0) || !(options.max_drift_rate <= 1.0)) {
+    throw std::invalid_argument("max_drift_rate must lie in [0, 1] s/s, got " +
+                                std::to_string(options.max_drift_rate));
+  }
+  max_drift_rate_ = options.max_drift_rate;
   bucket_ns_ =
       std::max<std::int64_t>(1, std::llround(options.window * kNanosecondsPerSecond / kBuckets));
   max_offset_ns_ = std::llround(options.max_offset * kNanosecondsPerSecond);
@@ -71,7 +79,27 @@ std::int64_t StampCorrection::offsetFor(std::int64_t stamp_ns, std::int64_t rece
     return own;
   }
   std::int64_t skew = 0;
-  return minimum(receipt_ns, &skew) ? skew : own;
+  const std::int64_t target = minimum(receipt_ns, &skew) ? skew : own;
+  if (!have_offset_) {
+    return target;
+  }
+  // |o − o_used| <= rate × elapsed; a receipt before the last one's (not expected on one
+  // timeline) allows no drift.
+  const double elapsed = static_cast<double>(std::max<std::int64_t>(0, receipt_ns - offset_at_));
+  const auto step = static_cast<std::int64_t>(
+      std::min(max_drift_rate_ * elapsed, static_cast<double>(2 * kMaxNs)));
+  return std::clamp(target, offset_ns_ - step, offset_ns_ + step);
+}
+
+void StampCorrection::accepted(std::int64_t stamp_ns, std::int64_t receipt_ns,
+                               std::int64_t offset_ns) {
+  accepted(stamp_ns, receipt_ns);
+  if (options_.policy == ClockPolicy::kEstimate && stamp_ns != 0 && offset_ns < kMaxNs &&
+      offset_ns > -kMaxNs) {
+    have_offset_ = true;
+    offset_ns_ = offset_ns;
+    offset_at_ = receipt_ns;
+  }
 }
 
 void StampCorrection::accepted(std::int64_t stamp_ns, std::int64_t receipt_ns) {
@@ -92,6 +120,7 @@ void StampCorrection::accepted(std::int64_t stamp_ns, std::int64_t receipt_ns) {
 
 void StampCorrection::reset() {
   buckets_.fill(Bucket{});
+  have_offset_ = false;
   last_skew_ = std::numeric_limits<double>::quiet_NaN();
 }
 

@@ -342,6 +342,7 @@ StampCorrectionOptions readClockSkewOptions(NodeOptionReader& reader) {
   }
   o.window = reader.number("clock_skew/window", o.window, 1e-3, 1e6);
   o.max_offset = reader.number("clock_skew/max_offset", o.max_offset, 0.0, 1e6);
+  o.max_drift_rate = reader.number("clock_skew/max_drift_rate", o.max_drift_rate, 0.0, 1.0);
   return o;
 }
 

@@ -14,11 +14,13 @@ namespace {
 constexpr std::int64_t kSecond = 1000000000;
 constexpr std::int64_t kMs = 1000000;
 
-StampCorrection correctionOf(ClockPolicy policy, double window = 10.0, double max_offset = 60.0) {
+StampCorrection correctionOf(ClockPolicy policy, double window = 10.0, double max_offset = 60.0,
+                             double max_drift_rate = 1e-3) {
   StampCorrectionOptions o;
   o.policy = policy;
   o.window = window;
   o.max_offset = max_offset;
+  o.max_drift_rate = max_drift_rate;
   return StampCorrection(o);
 }
 
@@ -66,29 +68,47 @@ TEST(StampCorrection, EstimateForgetsWhatLeftTheWindow) {
   EXPECT_TRUE(std::isnan(c.minimumSkew(4 * kSecond)));  // both have
 }
 
-TEST(StampCorrection, AClockStepOfTheSenderForwardIsFollowedAtOnce) {
-  StampCorrection c = correctionOf(ClockPolicy::kEstimate);
+TEST(StampCorrection, AClockStepOfTheSenderMovesTheOffsetOnlyAtTheDriftRate) {
+  StampCorrection c = correctionOf(ClockPolicy::kEstimate);  // 1 ms a second
   std::int64_t receipt = 50 * kSecond;
   for (int k = 0; k < 100; ++k, receipt += 10 * kMs) {
-    c.accepted(receipt - 1 * kMs, receipt);
+    const std::int64_t stamp = receipt - 1 * kMs;
+    c.accepted(stamp, receipt, c.offsetFor(stamp, receipt));
   }
-  // The sender's clock jumps 3 s ahead: its skew becomes −3 s, smaller, so the minimum at once.
-  c.accepted(receipt + 3 * kSecond - 1 * kMs, receipt);
-  const std::int64_t stamp = receipt + 10 * kMs + 3 * kSecond - 1 * kMs;
-  EXPECT_EQ(stamp + c.offsetFor(stamp, receipt + 10 * kMs), receipt + 10 * kMs);
+  // The sender's clock jumps 3 s ahead: its skew becomes −3 s, the window's minimum at once,
+  // but the offset moves by 1 ms a second from 1 ms (InputTimeline refuses the stamps as
+  // ahead of the clock until it starts afresh).
+  c.accepted(receipt + 3 * kSecond - 1 * kMs, receipt, kMs);
+  EXPECT_NEAR(c.minimumSkew(receipt), -3.0 + 0.001, 1e-12);
+  const std::int64_t stamp = receipt + 2 * kSecond + 3 * kSecond - 1 * kMs;
+  EXPECT_EQ(c.offsetFor(stamp, receipt + 2 * kSecond), kMs - 2 * kMs);
+  // Without an offset used before (the first message, or after reset()) it is the minimum.
+  c.reset();
+  EXPECT_EQ(c.offsetFor(stamp, receipt + 2 * kSecond), receipt - stamp + 2 * kSecond);
 }
 
-TEST(StampCorrection, SkewsBeyondMaxOffsetAreMeasuredButNotLearnt) {
-  StampCorrection c = correctionOf(ClockPolicy::kEstimate, 10.0, 5.0);
-  c.accepted(100 * kSecond - 2 * kMs, 100 * kSecond);
-  c.accepted(100 * kSecond + 3600 * kSecond, 100 * kSecond + 10 * kMs);  // an hour ahead
-  EXPECT_DOUBLE_EQ(c.lastSkew(), -3600.0 + 0.01);
-  EXPECT_NEAR(c.minimumSkew(100 * kSecond + 10 * kMs), 0.002, 1e-12);
-  // Stamps at the ends of ros::Time's range do not overflow.
-  const std::int64_t latest = std::int64_t{4294967295} * kSecond + 999999999;
-  c.accepted(latest, 100 * kSecond);
-  EXPECT_LT(c.lastSkew(), -4e9);
-  EXPECT_NEAR(c.minimumSkew(100 * kSecond + 10 * kMs), 0.002, 1e-12);
+/// The offset after @p messages 10 ms apart, each stamped @p lead ns further from a 2 ms delay
+/// than the one before.
+std::int64_t offsetAfterALead(std::int64_t lead, int messages) {
+  StampCorrection c = correctionOf(ClockPolicy::kEstimate);  // 1 ms a second
+  std::int64_t receipt = 100 * kSecond;
+  std::int64_t offset = 0;
+  for (int k = 0; k < messages; ++k, receipt += 10 * kMs) {
+    const std::int64_t stamp = receipt - 2 * kMs + k * lead;
+    offset = c.offsetFor(stamp, receipt);
+    c.accepted(stamp, receipt, offset);
+  }
+  return offset;
+}
+
+TEST(StampCorrection, ASenderLeadingItsStampsCannotLeadTheEstimate) {
+  // Every message 1 ms further ahead: by 4 s its stamps are 0.4 s ahead; the offset moved 4 ms.
+  EXPECT_NEAR(static_cast<double>(offsetAfterALead(kMs, 400) - 2 * kMs) / kSecond, -0.004, 3e-5);
+  // A delay growing by 0.1 s/s for 20 s (2 s in all): the window's minimum grows by 1 s once the
+  // first 10 s have left it, the offset by at most 20 ms; the rest stays visible as age.
+  const double moved = static_cast<double>(offsetAfterALead(-kMs, 2000) - 2 * kMs) / kSecond;
+  EXPECT_GT(moved, 0.0);
+  EXPECT_LE(moved, 0.020 + 1e-9);
 }
 
 TEST(StampCorrection, ResetForgetsEverything) {
@@ -101,9 +121,10 @@ TEST(StampCorrection, ResetForgetsEverything) {
 }
 
 TEST(StampCorrection, OptionsOutOfRangeAreRefusedByName) {
-  const auto refused = [](double window, double max_offset, const char* key) {
+  const auto refused = [](double window, double max_offset, const char* key,
+                          double max_drift_rate = 1e-3) {
     try {
-      correctionOf(ClockPolicy::kEstimate, window, max_offset);
+      correctionOf(ClockPolicy::kEstimate, window, max_offset, max_drift_rate);
       ADD_FAILURE() << key << " accepted";
     } catch (const std::invalid_argument& e) {
       EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
@@ -113,6 +134,9 @@ TEST(StampCorrection, OptionsOutOfRangeAreRefusedByName) {
   refused(std::numeric_limits<double>::quiet_NaN(), 1.0, "window");
   refused(1.0, -1.0, "max_offset");
   refused(1.0, std::numeric_limits<double>::infinity(), "max_offset");
+  refused(1.0, 1.0, "max_drift_rate", -1e-3);
+  refused(1.0, 1.0, "max_drift_rate", 1.5);
+  refused(1.0, 1.0, "max_drift_rate", std::numeric_limits<double>::quiet_NaN());
 }
 
 }  // namespace

@@ -631,6 +631,11 @@ NODE_OPTIONS = [
          options={"clock_skew": {"policy": "estimate", "window": 0.0}}, nodes=(FOLLOWER,)),
     case("clock_skew max_offset < 0", "~clock_skew/max_offset",
          options={"clock_skew": {"max_offset": -1.0}}, nodes=(FOLLOWER,)),
+    case("clock_skew max_drift_rate > 1", "~clock_skew/max_drift_rate",
+         options={"clock_skew": {"policy": "estimate", "max_drift_rate": 2.0}},
+         nodes=(FOLLOWER,)),
+    case("clock_skew max_drift_rate NaN", "~clock_skew/max_drift_rate",
+         options={"clock_skew": {"max_drift_rate": NAN}}, nodes=(FOLLOWER,)),
     # follower_node
     opt("measurement_timeout < 0", FOLLOWER, "measurement_timeout", -1.0),
     opt("measurement_timeout = 0", FOLLOWER, "measurement_timeout", 0),

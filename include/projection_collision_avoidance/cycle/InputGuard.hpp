@@ -17,10 +17,12 @@ enum class Rejection : std::uint8_t {
   kRepeated,     ///< stamped exactly as the last accepted message
   kContent,      ///< wrong size, non-finite entries, wrong child frame (the caller's checks)
   kUnjudgeable,  ///< judging it failed (an exception while converting it)
+  kPublisher,    ///< sent by another publisher than the one that holds the input
+  kImplausible,  ///< stamped further from the receiver's clock than ~clock_skew/max_offset
 };
 
 /// "frame", "zero stamp", "future stamp", "stale", "out of order", "repeated stamp", "content",
-/// "unjudgeable".
+/// "unjudgeable", "other publisher", "implausible stamp".
 const char* toString(Rejection kind);
 
 /// What an input guard admits: the header checks of one input topic.

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <limits>
 #include <string>
+#include <string_view>
 #include <utility>
 
 #include "projection_collision_avoidance/cycle/InputGuard.hpp"
@@ -31,6 +32,10 @@ struct InputTimelineOptions {
   /// checkHeader() watches the receiver's clock and restarts the timeline when it goes back;
   /// false: the owner calls restart() itself (the plant, whose clock reports its own jumps).
   bool watch_time = true;
+  /// s, the input's timeout; 0: limits.max_age when it is > 0, else 1 s. A publisher holds the
+  /// input until it has not been heard for this long; a timeline whose every message is refused
+  /// for this long after its latest acceptance starts afresh.
+  double timeout = 0.0;
 };
 
 /// One input topic's timeline, free of ROS (stamps and times in ns since the epoch): the
@@ -39,7 +44,18 @@ struct InputTimelineOptions {
 /// checkHeader() notes the receiver's time (a jump back restarts the timeline: noteTime()), puts
 /// the stamp on the receiver's clock (the offset of StampCorrection, ~clock_skew/policy) and
 /// judges the header at the receiver's time moved by that offset (InputGuard: frame, zero stamp,
-/// future, stale, order on the raw stamps). The caller then checks and converts the content, and
+/// future, stale, order on the raw stamps). Before any of that it applies the rules that keep one
+/// message or one sender from taking the input (doc/boundary.md, "One sender, one timeline"):
+///  - one publisher at a time: the first publisher heard holds the input; another publisher's
+///    messages are refused (kPublisher) and counted (foreignMessages()) until the holder has not
+///    been heard for the timeout; then the next one heard takes the input and the timeline
+///    starts afresh (its order and offset are the new publisher's);
+///  - under ~clock_skew/policy receipt and estimate a raw stamp further than max_offset from the
+///    receiver's clock is refused (kImplausible) before it can touch the order or the offset;
+///  - a timeline that has refused every message for longer than the timeout since its latest
+///    acceptance (a stamp accepted far ahead that locks the order, a sender's clock that
+///    stepped) starts afresh (restarts()): it forgets its order and offset, not the age.
+/// The caller then checks and converts the content, and
 /// calls reject() or accept(); accept() returns the stamp on the receiver's clock, never before
 /// the one accepted before on this timeline (an estimated offset may shrink). The stamp and
 /// receipt time of the latest accepted message, the refusal count and the latest skew are
@@ -72,14 +88,18 @@ class InputTimeline {
   /// now − offset. False after counting a refusal (guard().lastKind(), takeLogLine()) or a
   /// superseded message (guard().lastSuperseded()); on true the caller checks the content and
   /// calls accept() or reject().
-  bool checkHeader(const std::string& frame_id, std::int64_t stamp_ns, std::int64_t now_ns);
+  /// @p publisher names the message's sender (roscpp's caller id); "" is any sender (a message
+  /// handed over within the node), to which the one-publisher rule does not apply.
+  bool checkHeader(const std::string& frame_id, std::int64_t stamp_ns, std::int64_t now_ns,
+                   std::string_view publisher = {});
 
   /// Takes a message without a header (geometry_msgs/Twist, say) received at @p now_ns: notes
   /// the time (with watch_time); its stamp is its receipt, so there is no header to judge, and
   /// messages received at one time (a clock that stands still) are not out of order. The caller
   /// checks the content and calls accept() (whose stamp still lies after the one before) or
   /// reject().
-  void checkReceipt(std::int64_t now_ns);
+  /// False after refusing it as another publisher's (kPublisher; see checkHeader()).
+  bool checkReceipt(std::int64_t now_ns, std::string_view publisher = {});
 
   /// Counts a refusal of @p kind of the message being judged; @p detail says what was wrong.
   void reject(Rejection kind, const std::string& detail);
@@ -114,6 +134,18 @@ class InputTimeline {
   /// The latest accepted message's skew, receipt − stamp (s, the raw stamp); NaN before one.
   /// Any thread.
   double skew() const { return skew_.load(std::memory_order_relaxed); }
+  /// Messages refused since start because another publisher held the input. Any thread.
+  std::uint64_t foreignMessages() const { return foreign_.load(std::memory_order_relaxed); }
+  /// Receipt time (ns) of the latest such message; kNone before one. Any thread.
+  std::int64_t foreignHeard() const { return foreign_heard_ns_.load(std::memory_order_relaxed); }
+  /// Times the input passed to another publisher after its holder went quiet. Any thread.
+  std::uint64_t handovers() const { return handovers_.load(std::memory_order_relaxed); }
+  /// Times the timeline started afresh after refusing everything for its timeout. Any thread.
+  std::uint64_t restarts() const { return restarts_.load(std::memory_order_relaxed); }
+  /// The publisher that holds the input ("" before one; input's thread).
+  const std::string& holder() const { return holder_; }
+  /// The timeout (s) in force (InputTimelineOptions::timeout resolved).
+  double timeout() const { return 1e-9 * static_cast<double>(timeout_ns_); }
 
   /// The admission's verdicts, counts and reasons (input's thread).
   const InputGuard& guard() const { return guard_; }
@@ -123,10 +155,30 @@ class InputTimeline {
   std::string takeLogLine() { return guard_.takeLogLine(); }
 
  private:
+  /// Capacity reserved for the holder's name, so that taking a name allocates nothing.
+  static constexpr std::size_t kHolderCapacity = 256;
+  /// checkHeader() after noting the time.
+  bool judgeHeader(const std::string& frame_id, std::int64_t stamp_ns, std::int64_t now_ns,
+                   std::string_view publisher);
+  /// The one-publisher rule: true when @p publisher may be judged at @p now_ns.
+  bool admitPublisher(std::string_view publisher, std::int64_t now_ns);
+  /// Forgets the order and the offset (a new holder, or a timeline locked out), not the age.
+  void startAfresh(std::int64_t now_ns);
+  /// Notes a refusal of the message being judged for the lock-out rule.
+  void noteRefusal();
+
   InputGuard guard_;
   StampCorrection correction_{StampCorrectionOptions{}};
   TimeJumpWatch jumps_;
   bool watch_time_ = true;
+  std::int64_t timeout_ns_ = 1000000000;
+  bool check_plausible_ = false;    ///< "receipt" and "estimate": refuse stamps beyond
+  std::int64_t max_offset_ns_ = 0;  ///< the implausible-stamp bound
+  std::string holder_;
+  std::int64_t holder_heard_ns_ = 0;
+  bool renew_holder_ = false;        ///< restart(): the holder's next hearing is dated then
+  std::int64_t quiet_since_ns_ = 0;  ///< the latest acceptance, or the start afresh
+  bool refused_since_ = false;       ///< a message was refused since quiet_since_ns_
   // The message being judged.
   std::int64_t raw_ns_ = 0;
   std::int64_t now_ns_ = 0;
@@ -137,6 +189,10 @@ class InputTimeline {
   std::atomic<std::uint64_t> rejected_{0};
   std::atomic<std::uint64_t> superseded_{0};
   std::atomic<double> skew_{std::numeric_limits<double>::quiet_NaN()};
+  std::atomic<std::uint64_t> foreign_{0};
+  std::atomic<std::int64_t> foreign_heard_ns_{kNone};
+  std::atomic<std::uint64_t> handovers_{0};
+  std::atomic<std::uint64_t> restarts_{0};
 };
 
 }  // namespace projection_collision_avoidance

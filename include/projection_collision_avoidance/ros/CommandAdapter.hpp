@@ -50,8 +50,8 @@ class CommandAdapter {
   CommandAdapter& operator=(const CommandAdapter&) = delete;
 
  private:
-  void onCommand(const geometry_msgs::AccelStamped::ConstPtr& msg);
-  void onOdometry(const nav_msgs::Odometry::ConstPtr& msg);
+  void onCommand(const ros::MessageEvent<geometry_msgs::AccelStamped const>& event);
+  void onOdometry(const ros::MessageEvent<nav_msgs::Odometry const>& event);
   void onWatchdog(const ros::SteadyTimerEvent& event);
   /// The counts of both inputs for `/diagnostics` (mutex_ held).
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);

@@ -3,9 +3,16 @@
 #include <cstdint>
 #include <exception>
 #include <string>
+#include <string_view>
 
+#include <boost/function.hpp>
+#include <ros/callback_queue_interface.h>
 #include <ros/console.h>
+#include <ros/message_event.h>
+#include <ros/node_handle.h>
+#include <ros/subscribe_options.h>
 #include <ros/time.h>
+#include <ros/transport_hints.h>
 #include <std_msgs/Header.h>
 
 #include "projection_collision_avoidance/cycle/InputGuard.hpp"
@@ -66,9 +73,38 @@ void admitGuarded(Admission& admission, const std::string& node, Judge&& judge) 
 
 /// InputTimeline::checkHeader() for a ROS header received at ROS time @p now (a jump back of
 /// ROS time restarts the timeline, the stamp is put on this clock, the header judged).
+/// @p publisher: the sender's caller id (publisherOf()), "" for a message handed over within the
+/// node (no one-publisher rule).
 inline bool checkHeader(InputTimeline& timeline, const std_msgs::Header& header,
-                        const ros::Time& now) {
-  return timeline.checkHeader(header.frame_id, nanosecondsOf(header.stamp), nanosecondsOf(now));
+                        const ros::Time& now, std::string_view publisher = {}) {
+  return timeline.checkHeader(header.frame_id, nanosecondsOf(header.stamp), nanosecondsOf(now),
+                              publisher);
+}
+
+/// The caller id of the node that published @p event's message, as roscpp's connection header
+/// gives it (nodelets of one manager share the manager's).
+template <typename Message>
+const std::string& publisherOf(const ros::MessageEvent<Message const>& event) {
+  return event.getPublisherName();
+}
+
+/// Subscribes @p topic (TCP_NODELAY unless @p hints say otherwise; on @p queue when given) with
+/// @p callback, which gets each message's ros::MessageEvent, so that its publisher is known
+/// (publisherOf()).
+template <typename Message, typename Callback>
+ros::Subscriber subscribeEvents(
+    ros::NodeHandle& nh, const std::string& topic, std::uint32_t queue_size, Callback&& callback,
+    const ros::TransportHints& hints = ros::TransportHints().tcpNoDelay(),
+    ros::CallbackQueueInterface* queue = nullptr) {
+  using Event = const ros::MessageEvent<Message const>&;
+  ros::SubscribeOptions options;
+  options.template initByFullCallbackType<Event>(
+      topic, queue_size, boost::function<void(Event)>(std::forward<Callback>(callback)));
+  options.transport_hints = hints;
+  if (queue != nullptr) {
+    options.callback_queue = queue;
+  }
+  return nh.subscribe(options);
 }
 
 /// TimeJumpWatch::wentBack() at ROS time @p now.

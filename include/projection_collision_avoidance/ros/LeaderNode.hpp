@@ -38,7 +38,7 @@ class LeaderNode {
   LeaderNode(ros::NodeHandle nh, ros::NodeHandle private_nh);
 
  private:
-  void onOdometry(const nav_msgs::Odometry::ConstPtr& msg);
+  void onOdometry(const ros::MessageEvent<nav_msgs::Odometry const>& event);
   void onTick(const ros::TimerEvent& event);
 
   ros::NodeHandle nh_;

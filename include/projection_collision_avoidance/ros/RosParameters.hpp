@@ -102,7 +102,8 @@ class NodeOptionReader {
 void echoScenario(const std::string& node_name, const ros::NodeHandle& private_nh,
                   const std::string& name = "scenario");
 
-/// ~clock_skew/{policy,window,max_offset} (doc/multi_host.md), each refused by its key.
+/// ~clock_skew/{policy,window,max_offset,max_drift_rate} (doc/multi_host.md), each refused by
+/// its key.
 StampCorrectionOptions readClockSkewOptions(NodeOptionReader& reader);
 
 }  // namespace projection_collision_avoidance

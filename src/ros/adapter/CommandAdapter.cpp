@@ -90,11 +90,12 @@ CommandAdapter::~CommandAdapter() {
   odometry_subscriber_.shutdown();
 }
 
-void CommandAdapter::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
+void CommandAdapter::onOdometry(const ros::MessageEvent<nav_msgs::Odometry const>& event) {
+  const nav_msgs::Odometry::ConstPtr& msg = event.getConstMessage();
   const std::lock_guard<std::mutex> lock(mutex_);
   admitGuarded(odometry_timeline_, name_, [&] {
     const ros::Time now = ros::Time::now();
-    if (!checkHeader(odometry_timeline_, msg->header, now)) {
+    if (!checkHeader(odometry_timeline_, msg->header, now, publisherOf(event))) {
       return;
     }
     // The heading in the world frame of the commands (tf2 when the odometry's frame differs).
@@ -127,14 +128,15 @@ void CommandAdapter::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
   });
 }
 
-void CommandAdapter::onCommand(const geometry_msgs::AccelStamped::ConstPtr& msg) {
+void CommandAdapter::onCommand(const ros::MessageEvent<geometry_msgs::AccelStamped const>& event) {
+  const geometry_msgs::AccelStamped::ConstPtr& msg = event.getConstMessage();
   const std::lock_guard<std::mutex> lock(mutex_);
   admitGuarded(command_timeline_, name_, [&] {
     const ros::Time now = ros::Time::now();
     if (command_timeline_.noteTime(nanosecondsOf(now))) {  // the timeline restarts
       watchdog_.reset();
     }
-    if (!checkHeader(command_timeline_, msg->header, now)) {
+    if (!checkHeader(command_timeline_, msg->header, now, publisherOf(event))) {
       return;
     }
     std::string why;

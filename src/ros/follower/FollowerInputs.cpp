@@ -88,18 +88,19 @@ void FollowerInputs::commandFrame(std::string* frame) const {
   *frame = command_frame_;
 }
 
-void FollowerInputs::onMeasurement(const RelativeMeasurement::ConstPtr& msg) {
-  admitMeasurement(*msg);
+void FollowerInputs::onMeasurement(const ros::MessageEvent<RelativeMeasurement const>& event) {
+  admitMeasurement(*event.getConstMessage(), publisherOf(event));
 }
 
-void FollowerInputs::admitMeasurement(const RelativeMeasurement& measurement) {
+void FollowerInputs::admitMeasurement(const RelativeMeasurement& measurement,
+                                      std::string_view publisher) {
   const RelativeMeasurement* msg = &measurement;
   InputTimeline& timeline = measurement_timeline_;
   admitGuarded(timeline, name_, [&] {
     const ros::Time now = ros::Time::now();
     // A jump back of ROS time restarts the timeline (the control cycle notes and reports the jump
     // itself); the header is judged on the sender's clock (~clock_skew/policy).
-    if (!checkHeader(timeline, msg->header, now)) {
+    if (!checkHeader(timeline, msg->header, now, publisher)) {
       if (timeline.guard().lastKind() == Rejection::kFuture) {
         cycle_->noteFutureMeasurement();  // this clock may still be catching up after a stall
       }
@@ -140,11 +141,12 @@ void FollowerInputs::admitMeasurement(const RelativeMeasurement& measurement) {
   }
 }
 
-void FollowerInputs::onLeaderBroadcast(const LeaderBroadcast::ConstPtr& msg) {
+void FollowerInputs::onLeaderBroadcast(const ros::MessageEvent<LeaderBroadcast const>& event) {
+  const LeaderBroadcast::ConstPtr& msg = event.getConstMessage();
   InputTimeline& timeline = leader_timeline_;
   admitGuarded(timeline, name_, [&] {
     const ros::Time now = ros::Time::now();
-    if (!checkHeader(timeline, msg->header, now)) {
+    if (!checkHeader(timeline, msg->header, now, publisherOf(event))) {
       return;
     }
     std::string why;
@@ -167,11 +169,12 @@ void FollowerInputs::onLeaderBroadcast(const LeaderBroadcast::ConstPtr& msg) {
   }
 }
 
-void FollowerInputs::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
+void FollowerInputs::onOdometry(const ros::MessageEvent<nav_msgs::Odometry const>& event) {
+  const nav_msgs::Odometry::ConstPtr& msg = event.getConstMessage();
   InputTimeline& timeline = odometry_timeline_;
   admitGuarded(timeline, name_, [&] {
     const ros::Time now = ros::Time::now();
-    if (!checkHeader(timeline, msg->header, now)) {
+    if (!checkHeader(timeline, msg->header, now, publisherOf(event))) {
       return;
     }
     // The conventions of ~odometry/pose_frame and ~odometry/twist_frame, as the odometry input

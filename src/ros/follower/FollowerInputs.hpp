@@ -79,7 +79,8 @@ class FollowerInputs {
   /// Judges a relative measurement (from the subscription, or made by an input adapter such as
   /// OdometryInput) and, if accepted, writes it into the cycle (and, with ~trigger measurement,
   /// runs its step). One caller at a time.
-  void admitMeasurement(const RelativeMeasurement& msg);
+  /// @p publisher: the sender's caller id; "" for a measurement made within the node.
+  void admitMeasurement(const RelativeMeasurement& msg, std::string_view publisher = {});
 
   /// The input adapter whose counts stats() reports (nullptr: none); set before start() and
   /// cleared before the adapter goes.
@@ -97,9 +98,9 @@ class FollowerInputs {
   void commandFrame(std::string* frame) const;
 
  private:
-  void onMeasurement(const RelativeMeasurement::ConstPtr& msg);
-  void onLeaderBroadcast(const LeaderBroadcast::ConstPtr& msg);
-  void onOdometry(const nav_msgs::Odometry::ConstPtr& msg);
+  void onMeasurement(const ros::MessageEvent<RelativeMeasurement const>& event);
+  void onLeaderBroadcast(const ros::MessageEvent<LeaderBroadcast const>& event);
+  void onOdometry(const ros::MessageEvent<nav_msgs::Odometry const>& event);
   std::string name_;
   FollowerNodeOptions options_;
   ControllerDesign design_;  ///< the start's: what the inputs read of it (period, time headway,

@@ -48,16 +48,16 @@ OdometryInput::OdometryInput(std::string node_name, const FollowerNodeOptions& o
 
 void OdometryInput::start(ros::NodeHandle nh) {
   tf_listener_ = std::make_unique<tf2_ros::TransformListener>(tf_buffer_, nh);
-  self_subscriber_ = nh.subscribe<nav_msgs::Odometry>(
-      "odom", 10, [this](const nav_msgs::Odometry::ConstPtr& msg) { onOdometry(&self_, msg); },
-      ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
-  target_subscriber_ = nh.subscribe<nav_msgs::Odometry>(
-      "target_odom", 10,
-      [this](const nav_msgs::Odometry::ConstPtr& msg) { onOdometry(&target_, msg); },
-      ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
+  using Event = ros::MessageEvent<nav_msgs::Odometry const>;
+  self_subscriber_ = subscribeEvents<nav_msgs::Odometry>(
+      nh, "odom", 10, [this](const Event& event) { onOdometry(&self_, event); });
+  target_subscriber_ = subscribeEvents<nav_msgs::Odometry>(
+      nh, "target_odom", 10, [this](const Event& event) { onOdometry(&target_, event); });
 }
 
-void OdometryInput::onOdometry(Side* side, const nav_msgs::Odometry::ConstPtr& msg) {
+void OdometryInput::onOdometry(Side* side,
+                               const ros::MessageEvent<nav_msgs::Odometry const>& event) {
+  const nav_msgs::Odometry::ConstPtr& msg = event.getConstMessage();
   const std::lock_guard<std::mutex> lock(mutex_);
   InputTimeline& timeline = side->timeline;
   const std::uint64_t before = timeline.rejected();
@@ -68,7 +68,7 @@ void OdometryInput::onOdometry(Side* side, const nav_msgs::Odometry::ConstPtr& m
       target_.timeline.restart();
       self_.have = target_.have = false;
     }
-    if (!checkHeader(timeline, msg->header, now)) {
+    if (!checkHeader(timeline, msg->header, now, publisherOf(event))) {
       return;
     }
     if (side == &self_ && options_.measurement_frame.empty()) {

@@ -71,7 +71,7 @@ class OdometryInput : public MeasurementAdapter {
     bool have = false;
   };
 
-  void onOdometry(Side* side, const nav_msgs::Odometry::ConstPtr& msg);
+  void onOdometry(Side* side, const ros::MessageEvent<nav_msgs::Odometry const>& event);
   /// The relative state of the latest pair to the sink (mutex_ held), or a refusal counted.
   void combine();
 

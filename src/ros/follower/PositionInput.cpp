@@ -54,18 +54,18 @@ void PositionInput::start(ros::NodeHandle nh) {
         nh.createTimer(ros::Duration(1.0 / options_.position.rate), &PositionInput::onTimer, this);
     return;
   }
-  point_subscriber_ = nh.subscribe<geometry_msgs::PointStamped>(
-      "target_position", 10,
-      [this](const geometry_msgs::PointStamped::ConstPtr& msg) {
-        onPosition(&point_timeline_, msg->header, vectorOf(msg->point));
-      },
-      ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
-  pose_subscriber_ = nh.subscribe<geometry_msgs::PoseStamped>(
-      "target_pose", 10,
-      [this](const geometry_msgs::PoseStamped::ConstPtr& msg) {
-        onPosition(&pose_timeline_, msg->header, vectorOf(msg->pose.position));
-      },
-      ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
+  point_subscriber_ = subscribeEvents<geometry_msgs::PointStamped>(
+      nh, "target_position", 10,
+      [this](const ros::MessageEvent<geometry_msgs::PointStamped const>& event) {
+        const geometry_msgs::PointStamped& msg = *event.getConstMessage();
+        onPosition(&point_timeline_, msg.header, vectorOf(msg.point), publisherOf(event));
+      });
+  pose_subscriber_ = subscribeEvents<geometry_msgs::PoseStamped>(
+      nh, "target_pose", 10,
+      [this](const ros::MessageEvent<geometry_msgs::PoseStamped const>& event) {
+        const geometry_msgs::PoseStamped& msg = *event.getConstMessage();
+        onPosition(&pose_timeline_, msg.header, vectorOf(msg.pose.position), publisherOf(event));
+      });
 }
 
 bool PositionInput::controlledPoint(std::string* frame, Eigen::Vector3d* point) {
@@ -79,7 +79,7 @@ bool PositionInput::controlledPoint(std::string* frame, Eigen::Vector3d* point) 
 }
 
 void PositionInput::onPosition(InputTimeline* timeline, const std_msgs::Header& header,
-                               const Eigen::Vector3d& p) {
+                               const Eigen::Vector3d& p, std::string_view publisher) {
   const std::lock_guard<std::mutex> lock(mutex_);
   const std::uint64_t before = timeline->rejected();
   admitGuarded(*timeline, name_, [&] {
@@ -89,7 +89,7 @@ void PositionInput::onPosition(InputTimeline* timeline, const std_msgs::Header& 
       pose_timeline_.restart();
       filter_.reset();
     }
-    if (!checkHeader(*timeline, header, now)) {
+    if (!checkHeader(*timeline, header, now, publisher)) {
       return;
     }
     if (!p.allFinite()) {

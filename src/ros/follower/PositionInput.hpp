@@ -48,9 +48,9 @@ class PositionInput : public MeasurementAdapter {
   bool controlledPoint(std::string* frame, Eigen::Vector3d* point) override;
 
  private:
-  /// One relative position p (m) with @p header, judged on @p timeline.
-  void onPosition(InputTimeline* timeline, const std_msgs::Header& header,
-                  const Eigen::Vector3d& p);
+  /// One relative position p (m) with @p header from @p publisher, judged on @p timeline.
+  void onPosition(InputTimeline* timeline, const std_msgs::Header& header, const Eigen::Vector3d& p,
+                  std::string_view publisher);
   /// The ~input tf lookups.
   void onTimer(const ros::TimerEvent& event);
   /// Filters p (in the world frame, stamped @p stamp) and hands on y = [p; v̂] once estimated;

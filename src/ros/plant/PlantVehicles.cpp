@@ -37,7 +37,8 @@ PlantVehicle::PlantVehicle(const VehicleOptions& options, Setup setup,
       setup_(std::move(setup)),
       odom_frame_(options.odom_frame),
       // Jumps back of the plant's time come from its clock (restartTimeline()).
-      twist_timeline_(setup_.agent_name + "/cmd_vel", {InputGuardLimits{}, {}, false}),
+      twist_timeline_(setup_.agent_name + "/cmd_vel",
+                      {InputGuardLimits{}, {}, false, setup_.command_timeout}),
       stamped_timeline_(
           setup_.agent_name + "/cmd_vel_stamped",
           {{"", setup_.command_timeout, setup_.command_timeout}, setup_.clock_skew, false}) {
@@ -77,13 +78,16 @@ void PlantVehicle::connect(ros::NodeHandle& nh, std::mutex* mutex, std::function
   const std::string& agent = setup_.agent_name;
   odom_publisher_ = nh.advertise<nav_msgs::Odometry>(agent + "/odom", 10);
   applied_publisher_ = nh.advertise<geometry_msgs::TwistStamped>(agent + "/applied_command", 10);
-  twist_subscriber_ = nh.subscribe<geometry_msgs::Twist>(
-      agent + "/cmd_vel", 10, [this](const geometry_msgs::Twist::ConstPtr& msg) { onTwist(*msg); },
-      ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
-  stamped_subscriber_ = nh.subscribe<geometry_msgs::TwistStamped>(
-      agent + "/cmd_vel_stamped", 10,
-      [this](const geometry_msgs::TwistStamped::ConstPtr& msg) { onTwistStamped(*msg); },
-      ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
+  twist_subscriber_ = subscribeEvents<geometry_msgs::Twist>(
+      nh, agent + "/cmd_vel", 10,
+      [this](const ros::MessageEvent<geometry_msgs::Twist const>& event) {
+        onTwist(*event.getConstMessage(), publisherOf(event));
+      });
+  stamped_subscriber_ = subscribeEvents<geometry_msgs::TwistStamped>(
+      nh, agent + "/cmd_vel_stamped", 10,
+      [this](const ros::MessageEvent<geometry_msgs::TwistStamped const>& event) {
+        onTwistStamped(*event.getConstMessage(), publisherOf(event));
+      });
 }
 
 bool PlantVehicle::commandOf(const geometry_msgs::Twist& twist, Eigen::Vector3d* command,
@@ -101,20 +105,22 @@ bool PlantVehicle::commandOf(const geometry_msgs::Twist& twist, Eigen::Vector3d*
   return true;
 }
 
-void PlantVehicle::onTwist(const geometry_msgs::Twist& twist) {
+void PlantVehicle::onTwist(const geometry_msgs::Twist& twist, std::string_view publisher) {
   const std::lock_guard<std::mutex> lock(*mutex_);
   admitGuarded(twist_timeline_, setup_.node_name, [&] {
     const ros::Time now = now_();
-    twist_timeline_.checkReceipt(nanosecondsOf(now));
-    hold(&twist_timeline_, twist, now);
+    if (twist_timeline_.checkReceipt(nanosecondsOf(now), publisher)) {
+      hold(&twist_timeline_, twist, now);
+    }
   });
 }
 
-void PlantVehicle::onTwistStamped(const geometry_msgs::TwistStamped& message) {
+void PlantVehicle::onTwistStamped(const geometry_msgs::TwistStamped& message,
+                                  std::string_view publisher) {
   const std::lock_guard<std::mutex> lock(*mutex_);
   admitGuarded(stamped_timeline_, setup_.node_name, [&] {
     const ros::Time now = now_();
-    if (checkHeader(stamped_timeline_, message.header, now)) {
+    if (checkHeader(stamped_timeline_, message.header, now, publisher)) {
       hold(&stamped_timeline_, message.twist, now);
     }
   });

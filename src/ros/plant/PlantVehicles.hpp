@@ -106,8 +106,8 @@ class PlantVehicle {
   /// The command of a Twist's content; false, with the reason, when it is refused.
   bool commandOf(const geometry_msgs::Twist& twist, Eigen::Vector3d* command,
                  std::string* why) const;
-  void onTwist(const geometry_msgs::Twist& twist);
-  void onTwistStamped(const geometry_msgs::TwistStamped& message);
+  void onTwist(const geometry_msgs::Twist& twist, std::string_view publisher);
+  void onTwistStamped(const geometry_msgs::TwistStamped& message, std::string_view publisher);
   /// Holds @p twist received at @p now, admitted so far by @p timeline: its content judged, then
   /// accepted or refused there.
   void hold(InputTimeline* timeline, const geometry_msgs::Twist& twist, const ros::Time& now);

@@ -225,10 +225,10 @@ void PlantWorld::connectAgent(Agent* agent) {
     }
     if (options_.lockstep) {
       agent->controller_subscriber =
-          subscribeCommand(agent, [this, agent](const geometry_msgs::AccelStamped::ConstPtr& msg) {
+          subscribeCommand(agent, [this, agent](const CommandEvent& event) {
             const std::lock_guard<std::mutex> lock(mutex_);
             agent->controller_stamp =
-                std::max(agent->controller_stamp, nanosecondsOf(msg->header.stamp));
+                std::max(agent->controller_stamp, nanosecondsOf(event.getMessage()->header.stamp));
           });
     }
     return;
@@ -237,23 +237,18 @@ void PlantWorld::connectAgent(Agent* agent) {
   agent->applied_command_publisher.advertise<geometry_msgs::AccelStamped>(
       nh_, agent->name + "/applied_command", 10);
   agent->command_subscriber = subscribeCommand(
-      agent,
-      [this, agent](const geometry_msgs::AccelStamped::ConstPtr& msg) { onCommand(agent, msg); });
+      agent, [this, agent](const CommandEvent& event) { onCommand(agent, event); });
 }
 
 ros::Subscriber PlantWorld::subscribeCommand(
-    Agent* agent,
-    const boost::function<void(const geometry_msgs::AccelStamped::ConstPtr&)>& callback) {
-  ros::SubscribeOptions subscription;
-  subscription.init<geometry_msgs::AccelStamped>(agent->name + "/command", 10, callback);
-  subscription.transport_hints = ros::TransportHints().tcpNoDelay();
-  if (PlantClock::ticksOnThread(options_)) {
-    subscription.callback_queue = &command_queue_;
-  }
-  return nh_.subscribe(subscription);
+    Agent* agent, const boost::function<void(const CommandEvent&)>& callback) {
+  return subscribeEvents<geometry_msgs::AccelStamped>(
+      nh_, agent->name + "/command", 10, callback, ros::TransportHints().tcpNoDelay(),
+      PlantClock::ticksOnThread(options_) ? &command_queue_ : nullptr);
 }
 
-void PlantWorld::onCommand(Agent* agent, const geometry_msgs::AccelStamped::ConstPtr& msg) {
+void PlantWorld::onCommand(Agent* agent, const CommandEvent& event) {
+  const geometry_msgs::AccelStamped::ConstPtr& msg = event.getConstMessage();
   const std::lock_guard<std::mutex> lock(mutex_);
   InputTimeline& timeline = agent->command_timeline;
   admitGuarded(timeline, name_, [&] {
@@ -269,7 +264,7 @@ void PlantWorld::onCommand(Agent* agent, const geometry_msgs::AccelStamped::Cons
     }
     // Judged on the sender's clock, its order on the raw stamps and its age against the plant's
     // time moved by the offset of ~clock_skew/policy (0 by default), as the follower does.
-    if (!checkHeader(timeline, msg->header, plantNow())) {
+    if (!checkHeader(timeline, msg->header, plantNow(), publisherOf(event))) {
       return;
     }
     std::string why;

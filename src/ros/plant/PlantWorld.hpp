@@ -114,7 +114,8 @@ class PlantWorld {
   void connectAgent(Agent* agent);
   /// The plant's time: the last tick's stamp, or ROS time before the clock runs.
   ros::Time plantNow() const { return clock_ ? clock_->now() : ros::Time::now(); }
-  void onCommand(Agent* agent, const geometry_msgs::AccelStamped::ConstPtr& msg);
+  using CommandEvent = ros::MessageEvent<geometry_msgs::AccelStamped const>;
+  void onCommand(Agent* agent, const CommandEvent& event);
   /// Publishes the agent's odometry at @p stamp and appends its transform.
   void sampleAgent(Agent* agent, const ros::Time& stamp,
                    std::vector<geometry_msgs::TransformStamped>* transforms);
@@ -134,9 +135,8 @@ class PlantWorld {
   bool everyAgentCommanded() const;
   /// A subscriber of @p agent's command topic (`<agent>/command`), on the tick thread's queue
   /// when the plant ticks on a thread of its own.
-  ros::Subscriber subscribeCommand(
-      Agent* agent,
-      const boost::function<void(const geometry_msgs::AccelStamped::ConstPtr&)>& callback);
+  ros::Subscriber subscribeCommand(Agent* agent,
+                                   const boost::function<void(const CommandEvent&)>& callback);
   void publishMarkers(const ros::Time& stamp);
   /// The agent a follower is measured against.
   const Agent& targetOf(const Follower& follower) const;

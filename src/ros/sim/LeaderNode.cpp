@@ -50,11 +50,12 @@ LeaderNode::LeaderNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
                         << (options_.share_disturbance ? "shared" : "not shared"));
 }
 
-void LeaderNode::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
+void LeaderNode::onOdometry(const ros::MessageEvent<nav_msgs::Odometry const>& event) {
+  const nav_msgs::Odometry::ConstPtr& msg = event.getConstMessage();
   const std::lock_guard<std::mutex> lock(mutex_);
   admitGuarded(odometry_timeline_, name_, [&] {
     const ros::Time now = ros::Time::now();
-    if (!checkHeader(odometry_timeline_, msg->header, now)) {
+    if (!checkHeader(odometry_timeline_, msg->header, now, publisherOf(event))) {
       return;
     }
     if (!sameFrame(msg->child_frame_id, options_.leader_frame)) {
