@@ -65,6 +65,8 @@ class InputTimeline {
  public:
   /// Receipt time of "nothing accepted on this timeline".
   static constexpr std::int64_t kNone = -1;
+  /// How long (ns) after another publisher's latest message the diagnostics report it (ERROR).
+  static constexpr std::int64_t kForeignReportNs = 10000000000;
 
   InputTimeline() = default;
   /// @param topic the input's name in log lines

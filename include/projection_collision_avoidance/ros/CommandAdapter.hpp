@@ -9,10 +9,10 @@
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
 #include <tf2_ros/buffer.h>
-#include <tf2_ros/transform_listener.h>
 
 #include "projection_collision_avoidance/cycle/InputGuard.hpp"
 #include "projection_collision_avoidance/cycle/InputTimeline.hpp"
+#include "projection_collision_avoidance/ros/GuardedTransformListener.hpp"
 #include "projection_collision_avoidance/ros/InputAdmission.hpp"
 #include "projection_collision_avoidance/vehicle/CommandConverter.hpp"
 #include "projection_collision_avoidance/vehicle/OutputWatchdog.hpp"
@@ -75,7 +75,7 @@ class CommandAdapter {
   diagnostic_updater::Updater diagnostics_;
 
   tf2_ros::Buffer tf_buffer_;
-  std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
+  std::unique_ptr<GuardedTransformListener> tf_listener_;
   ros::Publisher accel_publisher_;
   ros::Publisher twist_publisher_;
   ros::Publisher twist_stamped_publisher_;

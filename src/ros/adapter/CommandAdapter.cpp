@@ -8,6 +8,7 @@
 #include <geometry_msgs/Vector3Stamped.h>
 
 #include "projection_collision_avoidance/cycle/FrameNames.hpp"
+#include "projection_collision_avoidance/ros/GuardedTransformListener.hpp"
 #include "projection_collision_avoidance/ros/MessageConversions.hpp"
 #include "projection_collision_avoidance/ros/OdometryFrames.hpp"
 #include "projection_collision_avoidance/ros/RosParameters.hpp"
@@ -65,7 +66,8 @@ CommandAdapter::CommandAdapter(ros::NodeHandle nh, ros::NodeHandle private_nh)
   if (options_->twist_stamped) {
     twist_stamped_publisher_ = nh.advertise<geometry_msgs::TwistStamped>("cmd_vel_stamped", 10);
   }
-  tf_listener_ = std::make_unique<tf2_ros::TransformListener>(tf_buffer_, nh);
+  tf_listener_ = std::make_unique<GuardedTransformListener>(
+      &tf_buffer_, nh, TransformGuardOptions{options_->max_future_stamp}, name_);
   command_frame_ =
       std::make_unique<CommandFrame>(name_, &tf_buffer_, options_->world_frame.empty());
   odometry_subscriber_ = nh.subscribe("odom", 10, &CommandAdapter::onOdometry, this,
@@ -188,6 +190,20 @@ void CommandAdapter::diagnose(diagnostic_updater::DiagnosticStatusWrapper& statu
   if (!command_frame_->warning().empty()) {
     status.mergeSummary(DiagnosticStatus::WARN, command_frame_->warning());
   }
+  const std::int64_t now_ns = nanosecondsOf(ros::Time::now());
+  for (const InputTimeline* timeline : {&command_timeline_, &odometry_timeline_}) {
+    const std::int64_t heard = timeline->foreignHeard();
+    if (heard != InputTimeline::kNone && now_ns >= heard &&
+        now_ns - heard <= InputTimeline::kForeignReportNs) {
+      status.mergeSummary(DiagnosticStatus::ERROR,
+                          "another publisher on " +
+                              std::string(timeline == &command_timeline_ ? "command" : "odom") +
+                              " (refused: " + timeline->holder() + " holds it)");
+    }
+  }
+  status.add("foreign_commands", command_timeline_.foreignMessages());
+  status.add("foreign_odometry", odometry_timeline_.foreignMessages());
+  status.add("input_restarts", command_timeline_.restarts() + odometry_timeline_.restarts());
   status.add("command_turned_by_tf", command_frame_->turned());
   status.add("accepted_commands", command_timeline_.guard().accepted());
   status.add("rejected_commands", command_timeline_.rejected());

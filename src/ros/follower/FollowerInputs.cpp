@@ -68,10 +68,20 @@ FollowerInputStats FollowerInputs::stats(std::int64_t now_ns) const {
   stats.measurement_skew = measurement_timeline_.skew();
   stats.leader_skew = leader_timeline_.skew();
   stats.clock_offset = clock_offset_.load(std::memory_order_relaxed);
+  for (const InputTimeline* timeline :
+       {&measurement_timeline_, &leader_timeline_, &odometry_timeline_}) {
+    stats.foreign_messages += timeline->foreignMessages();
+    stats.foreign_heard_ns = std::max(stats.foreign_heard_ns, timeline->foreignHeard());
+    stats.input_restarts += timeline->restarts();
+    stats.input_handovers += timeline->handovers();
+  }
   if (const MeasurementAdapter* adapter = adapter_.load(std::memory_order_acquire)) {
     stats.rejected_input = adapter->rejected();
     stats.superseded_input = adapter->superseded();
     stats.input_skew = adapter->skew();
+    stats.foreign_messages += adapter->foreignMessages();
+    stats.foreign_heard_ns = std::max(stats.foreign_heard_ns, adapter->foreignHeard());
+    stats.input_restarts += adapter->restarts();
   }
   const std::lock_guard<std::mutex> lock(reasons_mutex_);
   stats.measurement_rejection = measurement_rejection_;

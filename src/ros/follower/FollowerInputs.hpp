@@ -47,6 +47,14 @@ struct FollowerInputStats {
   double measurement_skew = std::numeric_limits<double>::quiet_NaN();
   double leader_skew = std::numeric_limits<double>::quiet_NaN();
   double clock_offset = 0.0;  ///< s, added to the latest accepted measurement's stamp
+  /// Messages of every input refused because another publisher held it (doc/boundary.md)
+  std::uint64_t foreign_messages = 0;
+  /// ns, receipt time of the latest of them; InputTimeline::kNone before one
+  std::int64_t foreign_heard_ns = InputTimeline::kNone;
+  /// Times an input's timeline started afresh after refusing everything for its timeout, or
+  /// passed to another publisher after its holder went quiet
+  std::uint64_t input_restarts = 0;
+  std::uint64_t input_handovers = 0;
 };
 
 /// The follower's inputs: subscribes `relative_measurement` (with ~input relative_measurement;

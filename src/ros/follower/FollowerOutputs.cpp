@@ -217,6 +217,13 @@ void FollowerOutputs::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat
     status.mergeSummary(DiagnosticStatus::WARN,
                         "rejecting leader broadcasts: " + inputs.leader_rejection);
   }
+  const std::int64_t now_ns = nanosecondsOf(ros::Time::now());
+  if (inputs.foreign_heard_ns != InputTimeline::kNone && now_ns >= inputs.foreign_heard_ns &&
+      now_ns - inputs.foreign_heard_ns <= InputTimeline::kForeignReportNs) {
+    status.mergeSummary(DiagnosticStatus::ERROR, "another publisher on an input (" +
+                                                     std::to_string(inputs.foreign_messages) +
+                                                     " messages refused)");
+  }
   status.add("mode", toString(s.mode));
   status.add("xi_norm (m)", xi_norm);
   status.add("xi_max (m)", s.xi_max);
@@ -248,6 +255,9 @@ void FollowerOutputs::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat
   status.add("clock_offset (s)", inputs.clock_offset);
   status.add("clock_skew_policy", toString(options_.clock_skew.policy));
   status.add("leader_age (s)", inputs.leader_age);
+  status.add("foreign_messages", inputs.foreign_messages);
+  status.add("input_restarts", inputs.input_restarts);
+  status.add("input_handovers", inputs.input_handovers);
   status.add("time_jumps", s.time_jumps);
   status.add("trigger", toString(options_.trigger));
   status.add("control_loop", toString(options_.control_loop));

@@ -10,6 +10,7 @@
 #include <ros/ros.h>
 
 #include "projection_collision_avoidance/RelativeMeasurement.h"
+#include "projection_collision_avoidance/cycle/InputTimeline.hpp"
 
 #include "follower/FollowerOptions.hpp"
 
@@ -31,6 +32,12 @@ class MeasurementAdapter {
   /// Messages dropped as superseded so far: stamped at or before the latest accepted one of their
   /// topic (doc/boundary.md), not refusals (any thread).
   virtual std::uint64_t superseded() const { return 0; }
+  /// What its inputs' one-publisher rule refused (any thread): the messages, and the receipt time
+  /// (ns) of the latest, InputTimeline::kNone before one.
+  virtual std::uint64_t foreignMessages() const { return 0; }
+  virtual std::int64_t foreignHeard() const { return InputTimeline::kNone; }
+  /// Times its inputs' timelines started afresh after refusing everything for their timeout.
+  virtual std::uint64_t restarts() const { return 0; }
   /// The latest |t_target − t_self| of two samples combined (s); NaN when not applicable.
   virtual double skew() const { return std::numeric_limits<double>::quiet_NaN(); }
   /// The world frame and the world position (m) of the own controlled point; false when this

@@ -5,6 +5,7 @@
 #include <utility>
 
 #include "projection_collision_avoidance/cycle/FrameNames.hpp"
+#include "projection_collision_avoidance/ros/GuardedTransformListener.hpp"
 #include "projection_collision_avoidance/ros/OdometryFrames.hpp"
 
 namespace projection_collision_avoidance {
@@ -47,7 +48,8 @@ OdometryInput::OdometryInput(std::string node_name, const FollowerNodeOptions& o
 }
 
 void OdometryInput::start(ros::NodeHandle nh) {
-  tf_listener_ = std::make_unique<tf2_ros::TransformListener>(tf_buffer_, nh);
+  tf_listener_ = std::make_unique<GuardedTransformListener>(
+      &tf_buffer_, nh, TransformGuardOptions{options_.max_future_stamp}, name_);
   using Event = ros::MessageEvent<nav_msgs::Odometry const>;
   self_subscriber_ = subscribeEvents<nav_msgs::Odometry>(
       nh, "odom", 10, [this](const Event& event) { onOdometry(&self_, event); });

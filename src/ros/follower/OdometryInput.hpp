@@ -9,11 +9,11 @@
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
 #include <tf2_ros/buffer.h>
-#include <tf2_ros/transform_listener.h>
 
 #include "projection_collision_avoidance/RelativeMeasurement.h"
 #include "projection_collision_avoidance/cycle/InputGuard.hpp"
 #include "projection_collision_avoidance/cycle/InputTimeline.hpp"
+#include "projection_collision_avoidance/ros/GuardedTransformListener.hpp"
 #include "projection_collision_avoidance/ros/InputAdmission.hpp"
 #include "projection_collision_avoidance/vehicle/RelativeStateFromOdometry.hpp"
 
@@ -52,6 +52,16 @@ class OdometryInput : public MeasurementAdapter {
   /// Odometry messages superseded so far (both topics): stamped at or before the latest accepted.
   std::uint64_t superseded() const override {
     return self_.timeline.superseded() + target_.timeline.superseded();
+  }
+  std::uint64_t foreignMessages() const override {
+    return self_.timeline.foreignMessages() + target_.timeline.foreignMessages();
+  }
+  std::int64_t foreignHeard() const override {
+    return std::max(self_.timeline.foreignHeard(), target_.timeline.foreignHeard());
+  }
+  std::uint64_t restarts() const override {
+    return self_.timeline.restarts() + target_.timeline.restarts() + self_.timeline.handovers() +
+           target_.timeline.handovers();
   }
   /// The world frame and the world position (m) of the own controlled point at the latest own
   /// odometry; false before one.
@@ -97,7 +107,7 @@ class OdometryInput : public MeasurementAdapter {
   std::atomic<double> skew_;
 
   tf2_ros::Buffer tf_buffer_;
-  std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
+  std::unique_ptr<GuardedTransformListener> tf_listener_;
   ros::Subscriber self_subscriber_;
   ros::Subscriber target_subscriber_;
 };

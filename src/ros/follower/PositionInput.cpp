@@ -10,6 +10,7 @@
 
 #include "projection_collision_avoidance/core/ParameterError.hpp"
 #include "projection_collision_avoidance/cycle/FrameNames.hpp"
+#include "projection_collision_avoidance/ros/GuardedTransformListener.hpp"
 #include "projection_collision_avoidance/ros/MessageConversions.hpp"
 
 namespace projection_collision_avoidance {
@@ -48,7 +49,8 @@ PositionInput::PositionInput(std::string node_name, const FollowerNodeOptions& o
       skew_(std::numeric_limits<double>::quiet_NaN()) {}
 
 void PositionInput::start(ros::NodeHandle nh) {
-  tf_listener_ = std::make_unique<tf2_ros::TransformListener>(tf_buffer_, nh);
+  tf_listener_ = std::make_unique<GuardedTransformListener>(
+      &tf_buffer_, nh, TransformGuardOptions{options_.max_future_stamp}, name_);
   if (options_.input == MeasurementInput::kTf) {
     timer_ =
         nh.createTimer(ros::Duration(1.0 / options_.position.rate), &PositionInput::onTimer, this);

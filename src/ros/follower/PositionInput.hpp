@@ -9,11 +9,11 @@
 #include <geometry_msgs/PoseStamped.h>
 #include <ros/ros.h>
 #include <tf2_ros/buffer.h>
-#include <tf2_ros/transform_listener.h>
 
 #include "projection_collision_avoidance/cycle/InputGuard.hpp"
 #include "projection_collision_avoidance/cycle/InputTimeline.hpp"
 #include "projection_collision_avoidance/cycle/TimeJumpWatch.hpp"
+#include "projection_collision_avoidance/ros/GuardedTransformListener.hpp"
 #include "projection_collision_avoidance/ros/InputAdmission.hpp"
 #include "projection_collision_avoidance/vehicle/RelativeVelocityFilter.hpp"
 
@@ -43,6 +43,16 @@ class PositionInput : public MeasurementAdapter {
   /// Positions superseded (stamped at or before the latest accepted one of their topic).
   std::uint64_t superseded() const override {
     return point_timeline_.superseded() + pose_timeline_.superseded();
+  }
+  std::uint64_t foreignMessages() const override {
+    return point_timeline_.foreignMessages() + pose_timeline_.foreignMessages();
+  }
+  std::int64_t foreignHeard() const override {
+    return std::max(point_timeline_.foreignHeard(), pose_timeline_.foreignHeard());
+  }
+  std::uint64_t restarts() const override {
+    return point_timeline_.restarts() + pose_timeline_.restarts() + tf_timeline_.restarts() +
+           point_timeline_.handovers() + pose_timeline_.handovers();
   }
   double skew() const override { return skew_.load(std::memory_order_relaxed); }
   bool controlledPoint(std::string* frame, Eigen::Vector3d* point) override;
@@ -79,7 +89,7 @@ class PositionInput : public MeasurementAdapter {
   bool have_point_ = false;
 
   tf2_ros::Buffer tf_buffer_;
-  std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
+  std::unique_ptr<GuardedTransformListener> tf_listener_;
   ros::Subscriber point_subscriber_;
   ros::Subscriber pose_subscriber_;
   ros::Timer timer_;
