@@ -12,6 +12,8 @@ namespace projection_collision_avoidance {
 namespace {
 
 constexpr double kQuaternionTolerance = 1e-3;
+/// s the listener's thread waits for a message before it checks whether to stop.
+constexpr double kSpinWait = 0.01;
 
 bool finiteTransform(const geometry_msgs::Transform& t) {
   const double norm = std::sqrt(t.rotation.x * t.rotation.x + t.rotation.y * t.rotation.y +
@@ -29,13 +31,29 @@ GuardedTransformListener::GuardedTransformListener(tf2_ros::Buffer* buffer, ros:
       options_(options),
       name_(std::move(node_name)),
       guard_("tf", InputGuardLimits{}) {
+  buffer_->setUsingDedicatedThread(true);  // lookups with a timeout wait for this thread
   ros::NodeHandle root(nh, "/");
   const ros::TransportHints hints = ros::TransportHints().tcpNoDelay();
   using Event = ros::MessageEvent<tf2_msgs::TFMessage const>;
   dynamic_subscriber_ = subscribeEvents<tf2_msgs::TFMessage>(
-      root, "tf", 100, [this](const Event& event) { onMessage(event, false); }, hints);
+      root, "tf", 100, [this](const Event& event) { onMessage(event, false); }, hints, &queue_);
   static_subscriber_ = subscribeEvents<tf2_msgs::TFMessage>(
-      root, "tf_static", 100, [this](const Event& event) { onMessage(event, true); }, hints);
+      root, "tf_static", 100, [this](const Event& event) { onMessage(event, true); }, hints,
+      &queue_);
+  thread_ = std::thread([this] {
+    while (!stop_.load(std::memory_order_relaxed) && ros::ok()) {
+      queue_.callAvailable(ros::WallDuration(kSpinWait));
+    }
+  });
+}
+
+GuardedTransformListener::~GuardedTransformListener() {
+  stop_.store(true, std::memory_order_relaxed);
+  dynamic_subscriber_.shutdown();
+  static_subscriber_.shutdown();
+  if (thread_.joinable()) {
+    thread_.join();
+  }
 }
 
 void GuardedTransformListener::onMessage(const ros::MessageEvent<tf2_msgs::TFMessage const>& event,

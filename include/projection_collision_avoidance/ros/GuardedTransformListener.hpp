@@ -4,7 +4,9 @@
 #include <cstdint>
 #include <mutex>
 #include <string>
+#include <thread>
 
+#include <ros/callback_queue.h>
 #include <ros/ros.h>
 #include <tf2_msgs/TFMessage.h>
 #include <tf2_ros/buffer.h>
@@ -28,12 +30,17 @@ struct TransformGuardOptions {
 /// otherwise become the newest of its frame in the buffer, and every real one after it "old
 /// data" for the cache time (TF_OLD_DATA, a lookup at time 0 answered with the forged one).
 /// Refusals are counted and logged at most once a second by kind, then once a minute (InputGuard).
-/// When ROS time goes back the buffer is cleared, as tf2_ros::TransformListener does.
+/// When ROS time goes back the buffer is cleared, as tf2_ros::TransformListener does. As that
+/// listener, it takes the messages on a callback queue and thread of its own, so that a lookup
+/// that waits (a tf timeout) in another callback does not hold the transforms back.
 class GuardedTransformListener {
  public:
   /// Subscribes in @p nh's namespace root (`/tf`, `/tf_static`) with @p buffer outliving this.
   GuardedTransformListener(tf2_ros::Buffer* buffer, ros::NodeHandle nh,
                            const TransformGuardOptions& options, std::string node_name);
+  ~GuardedTransformListener();
+  GuardedTransformListener(const GuardedTransformListener&) = delete;
+  GuardedTransformListener& operator=(const GuardedTransformListener&) = delete;
 
   /// Transforms refused so far (any thread).
   std::uint64_t rejected() const { return rejected_.load(std::memory_order_relaxed); }
@@ -50,8 +57,11 @@ class GuardedTransformListener {
   InputGuard guard_;
   TimeJumpWatch clock_;
   std::atomic<std::uint64_t> rejected_{0};
+  ros::CallbackQueue queue_;
   ros::Subscriber dynamic_subscriber_;
   ros::Subscriber static_subscriber_;
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
 };
 
 }  // namespace projection_collision_avoidance
