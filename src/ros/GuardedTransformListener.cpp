@@ -32,13 +32,12 @@ GuardedTransformListener::GuardedTransformListener(tf2_ros::Buffer* buffer, ros:
       name_(std::move(node_name)),
       guard_("tf", InputGuardLimits{}) {
   buffer_->setUsingDedicatedThread(true);  // lookups with a timeout wait for this thread
-  ros::NodeHandle root(nh, "/");
   const ros::TransportHints hints = ros::TransportHints().tcpNoDelay();
   using Event = ros::MessageEvent<tf2_msgs::TFMessage const>;
   dynamic_subscriber_ = subscribeEvents<tf2_msgs::TFMessage>(
-      root, "tf", 100, [this](const Event& event) { onMessage(event, false); }, hints, &queue_);
+      nh, "/tf", 100, [this](const Event& event) { onMessage(event, false); }, hints, &queue_);
   static_subscriber_ = subscribeEvents<tf2_msgs::TFMessage>(
-      root, "tf_static", 100, [this](const Event& event) { onMessage(event, true); }, hints,
+      nh, "/tf_static", 100, [this](const Event& event) { onMessage(event, true); }, hints,
       &queue_);
   thread_ = std::thread([this] {
     while (!stop_.load(std::memory_order_relaxed) && ros::ok()) {

@@ -35,7 +35,8 @@ struct TransformGuardOptions {
 /// that waits (a tf timeout) in another callback does not hold the transforms back.
 class GuardedTransformListener {
  public:
-  /// Subscribes in @p nh's namespace root (`/tf`, `/tf_static`) with @p buffer outliving this.
+  /// Subscribes `/tf` and `/tf_static` (absolute names, as tf2_ros) with @p nh; @p buffer outlives
+  /// this.
   GuardedTransformListener(tf2_ros::Buffer* buffer, ros::NodeHandle nh,
                            const TransformGuardOptions& options, std::string node_name);
   ~GuardedTransformListener();
