@@ -47,12 +47,14 @@ PARALLEL = 12  # node processes at a time (they mostly wait on the master, not o
 FOLLOWER, PLANT, LEADER = "follower_node", "plant_node", "leader_node"
 ALL_NODES = (FOLLOWER, PLANT, LEADER)
 ADAPTER = "command_adapter"  # reads no scenario: only its own cases name it
+RELAY = "link_relay"  # only its own cases name it
 # What each node logs once it runs, i.e. once it has accepted its parameters.
 RUNNING = {
     FOLLOWER: ", running at ",
     PLANT: ": simulating a leader",
     LEADER: ": playing the leader's input",
     ADAPTER: "from command, stop after",
+    RELAY: " -> ",
 }
 NAN, INF = math.nan, math.inf
 MISSING = object()  # the ~scenario parameter is not set at all
@@ -794,6 +796,11 @@ NODE_OPTIONS = [
     opt("leader_frame a number", LEADER, "leader_frame", 3),
     opt("share_disturbance a string", LEADER, "share_disturbance", "false"),
     opt("share_disturbance an integer", LEADER, "share_disturbance", 0),
+    # link_relay
+    opt("relay max_in_flight_bytes below 1024", RELAY, "max_in_flight_bytes", 100),
+    opt("relay max_in_flight_bytes a double", RELAY, "max_in_flight_bytes", 1e6),
+    opt("relay max_future_stamp < 0", RELAY, "max_future_stamp", -0.1),
+    opt("relay max_future_stamp NaN", RELAY, "max_future_stamp", NAN),
 ]
 
 # outcome: "exited", "running" or "hung"; stopped: after "running", whether SIGINT ended it
