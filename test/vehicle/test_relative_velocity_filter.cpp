@@ -73,7 +73,9 @@ TEST(RelativeVelocityFilter, UnderConstantAccelerationTheVelocityLagsByTheStated
   for (const double omega : {5.0, 20.0, 50.0}) {
     const double dt = 0.01;
     const double a = -2.0;
-    RelativeVelocityFilter filter(optionsOf(3, omega));
+    VelocityFilterOptions o = optionsOf(3, omega);
+    o.max_speed = 100.0;  // 40 √2 m/s after 20 s
+    RelativeVelocityFilter filter(o);
     Eigen::VectorXd state;
     for (int k = 0; k <= 2000; ++k) {
       const double t = k * dt;
@@ -234,8 +236,8 @@ TEST(RelativeVelocityFilter, NoEstimateBeyondMaxSpeedLeavesTheFilter) {
   ASSERT_EQ(filter.update(0.02, Eigen::Vector3d(0.2, 0.05, 0), &state),
             VelocityFilterVerdict::kEstimated);
   EXPECT_NEAR(state(3), 5.0, 1e-9);
-  // The α-β update: a 1 m jump of one position drives v̂ beyond 10 m/s.
-  EXPECT_EQ(filter.update(0.03, Eigen::Vector3d(0.2, 1.1, 0), &state),
+  // The α-β update: a 2 m jump of one position drives v̂ to 5 + 2 (1 − θ)²/Δt = 11.6 m/s.
+  EXPECT_EQ(filter.update(0.03, Eigen::Vector3d(0.2, 2.1, 0), &state),
             VelocityFilterVerdict::kTooFast);
   // The glitch is where it started from: the next true position is too fast from it as well.
   EXPECT_EQ(filter.update(0.04, Eigen::Vector3d(0.2, 0.15, 0), &state),
