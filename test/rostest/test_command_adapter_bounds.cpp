@@ -12,12 +12,14 @@
 #include <vector>
 
 #include <geometry_msgs/AccelStamped.h>
+#include <geometry_msgs/TransformStamped.h>
 #include <geometry_msgs/Twist.h>
 #include <geometry_msgs/TwistStamped.h>
 #include <geometry_msgs/Vector3Stamped.h>
 #include <gtest/gtest.h>
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
+#include <tf2_ros/static_transform_broadcaster.h>
 
 #include "test_common.h"
 
@@ -163,7 +165,16 @@ class AdapterBoundsTest : public testing::RosTestFixture {
 };
 
 TEST_F(AdapterBoundsTest, AVelocityAdapterInTheBaseFrameSendsFiniteCommandsWithinItsLimits) {
-  // Its odometry in hostile/odom, turned from world by a static transform (the launch file's).
+  // Its odometry in hostile/odom, turned from world by ~turn.
+  const double turn = param("turn");
+  geometry_msgs::TransformStamped transform;
+  transform.header.stamp = ros::Time::now();
+  transform.header.frame_id = "world";
+  transform.child_frame_id = "hostile/odom";
+  transform.transform.rotation.z = std::sin(0.5 * turn);
+  transform.transform.rotation.w = std::cos(0.5 * turn);
+  tf2_ros::StaticTransformBroadcaster broadcaster;
+  broadcaster.sendTransform(transform);
   ASSERT_NO_FATAL_FAILURE(connect("hostile_velocity", "hostile/odom"));
   ASSERT_NO_FATAL_FAILURE(hostileSequence(true));
   expectBounded();
