@@ -30,6 +30,12 @@ Eigen::Vector3d padded(const Eigen::Ref<const Eigen::VectorXd>& v) {
 
 }  // namespace
 
+bool isFinite(const ConvertedCommand& command) {
+  return command.acceleration.allFinite() && command.velocity.allFinite() &&
+         std::isfinite(command.unicycle.velocity.v) &&
+         std::isfinite(command.unicycle.velocity.omega);
+}
+
 CommandConverter::CommandConverter(const CommandConverterOptions& options)
     : options_(options),
       integrator_(integratorOptions(options)),
@@ -110,6 +116,10 @@ const ConvertedCommand& CommandConverter::convert(
   if (options_.velocity_in_base_frame) {
     out_.velocity = worldToBody(own_.orientation, out_.velocity);
   }
+  if (!isFinite(out_)) {  // an overflow (R(q)ᵀ v of a huge v, a huge acceleration turned)
+    stop(now);
+    out_.replaced_non_finite = true;
+  }
   return out_;
 }
 
@@ -129,6 +139,9 @@ const ConvertedCommand& CommandConverter::stop(double now) {
     }
   } else {
     out_.heading_known = !(options_.unicycle || options_.velocity_in_base_frame);
+  }
+  if (!out_.acceleration.allFinite()) {
+    out_.acceleration.setZero();
   }
   return out_;
 }

@@ -14,6 +14,10 @@ const char* toString(VelocityFilterVerdict verdict) {
       return "started";
     case VelocityFilterVerdict::kNotIncreasing:
       return "stamp not increasing";
+    case VelocityFilterVerdict::kTooSoon:
+      return "too soon";
+    case VelocityFilterVerdict::kTooFast:
+      return "too fast";
     case VelocityFilterVerdict::kRefused:
     default:
       return "refused";
@@ -32,6 +36,14 @@ RelativeVelocityFilter::RelativeVelocityFilter(const VelocityFilterOptions& opti
   if (!(options.max_gap > 0.0) || !std::isfinite(options.max_gap)) {
     throw std::invalid_argument("max_gap must be finite and > 0 s, got " +
                                 std::to_string(options.max_gap));
+  }
+  if (!(options.min_interval > 0.0) || !(options.min_interval < options.max_gap)) {
+    throw std::invalid_argument("min_interval must be > 0 s and < max_gap, got " +
+                                std::to_string(options.min_interval));
+  }
+  if (!(options.max_speed > 0.0) || !std::isfinite(options.max_speed)) {
+    throw std::invalid_argument("max_speed must be finite and > 0 m/s, got " +
+                                std::to_string(options.max_speed));
   }
 }
 
@@ -53,6 +65,9 @@ VelocityFilterVerdict RelativeVelocityFilter::update(double t, const Eigen::Vect
     position_ = p;
     return VelocityFilterVerdict::kStarted;
   }
+  if (dt < options_.min_interval) {
+    return VelocityFilterVerdict::kTooSoon;
+  }
   if (samples_ == 1) {
     velocity_ = (p - position_) / dt;
     position_ = p;
@@ -68,6 +83,14 @@ VelocityFilterVerdict RelativeVelocityFilter::update(double t, const Eigen::Vect
   if (!velocity_.allFinite()) {  // an overflow: start again rather than carry it on
     samples_ = 0;
     return VelocityFilterVerdict::kRefused;
+  }
+  if (!(velocity_.head(k).norm() <= options_.max_speed)) {
+    // No vehicle pair moves so fast: a glitch of one of the two positions. Clamping would hand
+    // the controller a velocity as wrong in direction as in size; start again from this one
+    // (a glitch in it is then refused at the next position, the measurement ages meanwhile).
+    samples_ = 1;
+    position_ = p;
+    return VelocityFilterVerdict::kTooFast;
   }
   state->resize(2 * k);
   state->head(k) = p.head(k);

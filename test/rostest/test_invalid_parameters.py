@@ -47,12 +47,14 @@ PARALLEL = 12  # node processes at a time (they mostly wait on the master, not o
 FOLLOWER, PLANT, LEADER = "follower_node", "plant_node", "leader_node"
 ALL_NODES = (FOLLOWER, PLANT, LEADER)
 ADAPTER = "command_adapter"  # reads no scenario: only its own cases name it
+RELAY = "link_relay"  # only its own cases name it
 # What each node logs once it runs, i.e. once it has accepted its parameters.
 RUNNING = {
     FOLLOWER: ", running at ",
     PLANT: ": simulating a leader",
     LEADER: ": playing the leader's input",
     ADAPTER: "from command, stop after",
+    RELAY: " -> ",
 }
 NAN, INF = math.nan, math.inf
 MISSING = object()  # the ~scenario parameter is not set at all
@@ -608,6 +610,17 @@ NODE_OPTIONS = [
          options={"velocity": {"max_delay": 3.0}}, nodes=(ADAPTER,)),
     case("adapter velocity averaging_time zero", "~velocity/averaging_time",
          options={"velocity": {"averaging_time": 0.0}}, nodes=(ADAPTER,)),
+    # command_adapter: the output limits are finite and > 0 (0 no longer means none)
+    case("adapter velocity max_speed 0", "~velocity/max_speed",
+         options={"velocity": {"max_speed": 0.0}}, nodes=(ADAPTER,)),
+    case("adapter velocity max_speed inf", "~velocity/max_speed",
+         options={"velocity": {"max_speed": INF}}, nodes=(ADAPTER,)),
+    case("adapter unicycle max_speed NaN", "~unicycle/max_speed",
+         options={"outputs": "unicycle", "unicycle": {"max_speed": NAN}}, nodes=(ADAPTER,)),
+    case("adapter unicycle max_yaw_rate 0", "~unicycle/max_yaw_rate",
+         options={"outputs": "unicycle", "unicycle": {"max_yaw_rate": 0.0}}, nodes=(ADAPTER,)),
+    case("adapter unicycle max_yaw_rate past 1e4", "~unicycle/max_yaw_rate",
+         options={"outputs": "unicycle", "unicycle": {"max_yaw_rate": 1e5}}, nodes=(ADAPTER,)),
     on_input("tf without a world frame", "measurement_frame", "tf",
              **{"tf/self_frame": "follower", "tf/target_frame": "leader"}),
     on_input("tf without its own frame", "tf/self_frame", "tf", measurement_frame="world",
@@ -621,6 +634,18 @@ NODE_OPTIONS = [
     on_input("position velocity_bandwidth NaN", "position/velocity_bandwidth", "position",
              **{"position/velocity_bandwidth": NAN}),
     on_input("position max_gap 0", "position/max_gap", "position", **{"position/max_gap": 0.0}),
+    on_input("position min_interval 0", "position/min_interval", "position",
+             **{"position/min_interval": 0.0}),
+    on_input("position min_interval NaN", "position/min_interval", "position",
+             **{"position/min_interval": NAN}),
+    on_input("position min_interval not below max_gap", "position/min_interval", "position",
+             **{"position/min_interval": 0.2, "position/max_gap": 0.1}),
+    on_input("position max_speed 0", "position/max_speed", "position",
+             **{"position/max_speed": 0.0}),
+    on_input("position max_speed inf", "position/max_speed", "position",
+             **{"position/max_speed": INF}),
+    on_input("position max_speed a string", "position/max_speed", "position",
+             **{"position/max_speed": "fast"}),
     # follower_node: links and clocks (doc/multi_host.md)
     opt("transport unknown", FOLLOWER, "transport", "sctp"),
     opt("status_rate < 0", FOLLOWER, "status_rate", -1.0),
@@ -776,6 +801,11 @@ NODE_OPTIONS = [
     opt("leader_frame a number", LEADER, "leader_frame", 3),
     opt("share_disturbance a string", LEADER, "share_disturbance", "false"),
     opt("share_disturbance an integer", LEADER, "share_disturbance", 0),
+    # link_relay
+    opt("relay max_in_flight_bytes below 1024", RELAY, "max_in_flight_bytes", 100),
+    opt("relay max_in_flight_bytes a double", RELAY, "max_in_flight_bytes", 1e6),
+    opt("relay max_future_stamp < 0", RELAY, "max_future_stamp", -0.1),
+    opt("relay max_future_stamp NaN", RELAY, "max_future_stamp", NAN),
 ]
 
 # outcome: "exited", "running" or "hung"; stopped: after "running", whether SIGINT ended it

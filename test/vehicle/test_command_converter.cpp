@@ -3,6 +3,7 @@
 /// limits fed back, each kind's stop (braking acceleration), and the stop without a heading.
 
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -149,6 +150,54 @@ TEST(CommandConverter, ARepeatedStateIsDatedByItsFirstStamp) {
   moved.stamp = 1.15;  // the same state stamped earlier: dated by that stamp
   ASSERT_TRUE(converter.observe(moved));
   EXPECT_EQ(converter.stateChangedAt(), 1.15);
+}
+
+TEST(CommandConverter, ANonFiniteConversionGivesTheStopInstead) {
+  // A world-frame odometry twist of (1.5e308, 1.5e308) m/s, finite, turned into a base frame
+  // yawed by 45 deg: 2.1e308 overflows to inf.
+  CommandConverterOptions o = options(false, true);
+  o.odometry_twist_frame = TwistFrame::kWorld;
+  CommandConverter converter(o);
+  ASSERT_TRUE(converter.observe(own(10.0, M_PI / 4, 1.5e308, 1.5e308)));
+  const ConvertedCommand& c = converter.convert(accel(0.0, 0.0), 10.0);
+  EXPECT_TRUE(isFinite(c));
+  EXPECT_TRUE(c.replaced_non_finite);
+  EXPECT_TRUE(c.stop);
+  EXPECT_EQ(c.velocity, Eigen::Vector3d::Zero());
+  // An infinite acceleration (the adapter turns a huge finite one by tf): the stop, braking
+  // from the measured 1 m/s.
+  CommandConverter plain(options());
+  ASSERT_TRUE(plain.observe(own(10.0, 0.0, 1.0)));
+  const ConvertedCommand& d =
+      plain.convert(accel(std::numeric_limits<double>::infinity(), 0.0), 10.0);
+  EXPECT_TRUE(isFinite(d));
+  EXPECT_TRUE(d.replaced_non_finite);
+  EXPECT_NEAR(d.acceleration.x(), -1.0, 1e-12);
+  // The next finite command is converted again.
+  EXPECT_FALSE(plain.convert(accel(0.5, 0.0), 10.01).replaced_non_finite);
+}
+
+TEST(CommandConverter, AnOdometrySpikeGivesNoCommandBeyondTheLimits) {
+  // One odometry of 1000 m/s anchors the velocity command: it stays within the limits.
+  for (const bool base_frame : {false, true}) {
+    CommandConverterOptions o = options(false, base_frame);
+    o.velocity.max_speed = 4.0;
+    CommandConverter converter(o);
+    ASSERT_TRUE(converter.observe(own(10.0, 0.3, 1000.0, -20.0)));
+    const ConvertedCommand& c = converter.convert(accel(1.0, 0.0), 10.0);
+    EXPECT_TRUE(c.speed_limited);
+    EXPECT_LE(c.velocity.norm(), 4.0 * (1.0 + 1e-15)) << "base frame " << base_frame;
+  }
+  CommandConverterOptions o = options(true);
+  o.unicycle_limits.max_speed = 4.0;
+  o.unicycle_limits.max_yaw_rate = 3.0;
+  o.velocity.max_speed = 4.0;
+  CommandConverter unicycle(o);
+  ASSERT_TRUE(unicycle.observe(own(10.0, 0.3, 1000.0, 0.0, 500.0)));
+  const ConvertedCommand& c = unicycle.convert(accel(0.0, 2.0), 10.0);
+  EXPECT_LE(std::abs(c.unicycle.velocity.v), 4.0);
+  EXPECT_LE(std::abs(c.unicycle.velocity.omega), 3.0);
+  EXPECT_TRUE(isFinite(c));
 }
 
 TEST(CommandConverter, RefusesUnusableOptionsAndOdometry) {

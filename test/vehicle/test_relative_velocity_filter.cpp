@@ -1,6 +1,7 @@
 // The α-β filter that reconstructs the relative velocity from relative positions
 // (RelativeVelocityFilter): its start, its convergence rate, its lag under acceleration and its
 // refusals.
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -72,7 +73,9 @@ TEST(RelativeVelocityFilter, UnderConstantAccelerationTheVelocityLagsByTheStated
   for (const double omega : {5.0, 20.0, 50.0}) {
     const double dt = 0.01;
     const double a = -2.0;
-    RelativeVelocityFilter filter(optionsOf(3, omega));
+    VelocityFilterOptions o = optionsOf(3, omega);
+    o.max_speed = 100.0;  // 40 √2 m/s after 20 s
+    RelativeVelocityFilter filter(o);
     Eigen::VectorXd state;
     for (int k = 0; k <= 2000; ++k) {
       const double t = k * dt;
@@ -163,6 +166,89 @@ TEST(RelativeVelocityFilter, OptionsOutOfRangeAreRefusedByName) {
   o = optionsOf(2, 20.0);
   o.max_gap = -1.0;
   refused(o, "max_gap");
+  o = optionsOf(2, 20.0);
+  o.min_interval = 0.0;
+  refused(o, "min_interval");
+  o.min_interval = o.max_gap;  // no position could ever be used
+  refused(o, "min_interval");
+  o = optionsOf(2, 20.0);
+  o.max_speed = 0.0;
+  refused(o, "max_speed");
+  o.max_speed = std::numeric_limits<double>::infinity();
+  refused(o, "max_speed");
+}
+
+TEST(RelativeVelocityFilter, APositionTooSoonAfterTheLastUsedIsIgnored) {
+  RelativeVelocityFilter filter(optionsOf(1, 20.0));  // min_interval 0.005 s
+  Eigen::VectorXd state;
+  ASSERT_EQ(filter.update(0.0, Eigen::Vector3d(0, 0, 0), &state), VelocityFilterVerdict::kStarted);
+  EXPECT_EQ(filter.update(0.004, Eigen::Vector3d(0.5, 0, 0), &state),
+            VelocityFilterVerdict::kTooSoon);
+  // Measured from the last position used (t = 0), not from the ignored one.
+  ASSERT_EQ(filter.update(0.006, Eigen::Vector3d(0.006, 0, 0), &state),
+            VelocityFilterVerdict::kEstimated);
+  EXPECT_NEAR(state(1), 1.0, 1e-9);
+  // While estimating too.
+  EXPECT_EQ(filter.update(0.0069, Eigen::Vector3d(3.0, 0, 0), &state),
+            VelocityFilterVerdict::kTooSoon);
+  ASSERT_EQ(filter.update(0.016, Eigen::Vector3d(0.016, 0, 0), &state),
+            VelocityFilterVerdict::kEstimated);
+  EXPECT_NEAR(state(1), 1.0, 1e-9);
+}
+
+TEST(RelativeVelocityFilter, TwoPositionsAMicrosecondApartAfterAGapGiveNoPhantomVelocity) {
+  // After a gap beyond max_gap, two positions 1 µs and 1 cm apart: their difference quotient
+  // would be 10⁴ m/s. Then positions at 100 Hz of a pair at rest, some with 1 cm jumps.
+  VelocityFilterOptions o = optionsOf(2, 20.0);
+  RelativeVelocityFilter filter(o);
+  Eigen::VectorXd state;
+  filter.update(0.0, Eigen::Vector3d(1, 0, 0), &state);
+  filter.update(0.01, Eigen::Vector3d(1, 0, 0), &state);
+  const double t0 = 0.01 + 2.0 * o.max_gap;
+  EXPECT_EQ(filter.update(t0, Eigen::Vector3d(1, 0, 0), &state), VelocityFilterVerdict::kStarted);
+  EXPECT_NE(filter.update(t0 + 1e-6, Eigen::Vector3d(1.01, 0, 0), &state),
+            VelocityFilterVerdict::kEstimated);
+  double largest = 0.0;
+  int estimates = 0;
+  for (int k = 1; k <= 100; ++k) {
+    const double jump = (k % 7 == 0) ? 0.01 : 0.0;
+    if (filter.update(t0 + 0.01 * k, Eigen::Vector3d(1 + jump, 0, 0), &state) ==
+        VelocityFilterVerdict::kEstimated) {
+      ++estimates;
+      largest = std::max(largest, state.tail(2).norm());
+    }
+  }
+  EXPECT_EQ(estimates, 100);
+  EXPECT_LE(largest, o.max_speed);
+  EXPECT_LT(largest, 2.0);  // 1 cm over 10 ms at most, filtered
+}
+
+TEST(RelativeVelocityFilter, NoEstimateBeyondMaxSpeedLeavesTheFilter) {
+  VelocityFilterOptions o = optionsOf(2, 20.0);
+  o.max_speed = 10.0;
+  RelativeVelocityFilter filter(o);
+  Eigen::VectorXd state;
+  // The start's difference quotient: 20 m/s.
+  filter.update(0.0, Eigen::Vector3d(0, 0, 0), &state);
+  EXPECT_EQ(filter.update(0.01, Eigen::Vector3d(0.2, 0, 0), &state),
+            VelocityFilterVerdict::kTooFast);
+  // Started again from that position: 5 m/s from it is estimated.
+  ASSERT_EQ(filter.update(0.02, Eigen::Vector3d(0.2, 0.05, 0), &state),
+            VelocityFilterVerdict::kEstimated);
+  EXPECT_NEAR(state(3), 5.0, 1e-9);
+  // The α-β update: a 2 m jump of one position drives v̂ to 5 + 2 (1 − θ)²/Δt = 11.6 m/s.
+  EXPECT_EQ(filter.update(0.03, Eigen::Vector3d(0.2, 2.1, 0), &state),
+            VelocityFilterVerdict::kTooFast);
+  // The glitch is where it started from: the next true position is too fast from it as well.
+  EXPECT_EQ(filter.update(0.04, Eigen::Vector3d(0.2, 0.15, 0), &state),
+            VelocityFilterVerdict::kTooFast);
+  ASSERT_EQ(filter.update(0.05, Eigen::Vector3d(0.2, 0.2, 0), &state),
+            VelocityFilterVerdict::kEstimated);
+  EXPECT_NEAR(state(3), 5.0, 1e-9);
+  // A plausible change of the velocity is still estimated.
+  ASSERT_EQ(filter.update(0.06, Eigen::Vector3d(0.3, 0.2, 0), &state),
+            VelocityFilterVerdict::kEstimated);
+  EXPECT_LE(state.tail(2).norm(), o.max_speed);
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -55,7 +56,9 @@ class CommandAdapter {
   void onWatchdog(const ros::SteadyTimerEvent& event);
   /// The counts of both inputs for `/diagnostics` (mutex_ held).
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
-  /// Publishes @p command on every chosen output, stamped @p stamp (mutex_ held).
+  /// Publishes @p command on every chosen output, stamped @p stamp (mutex_ held): the one place
+  /// where output messages are filled. A command the converter replaced by its stop (not
+  /// finite) is counted; one not finite still is not published (counted too).
   void publish(const ConvertedCommand& command, const ros::Time& stamp);
 
   std::string name_;
@@ -69,6 +72,8 @@ class CommandAdapter {
   std::string base_frame_;   ///< ~base_frame, or the own odometry's child_frame_id
   Eigen::VectorXd acceleration_;
   bool warned_no_base_frame_ = false;
+  std::uint64_t replaced_outputs_ = 0;           ///< non-finite conversions sent as the stop
+  std::uint64_t unpublished_outputs_ = 0;        ///< non-finite commands not published
   std::unique_ptr<CommandFrame> command_frame_;  ///< the command's frame into world_frame_
   /// `/diagnostics` at 1 Hz of ROS time, from the watchdog's timer: accepted, rejected and
   /// superseded messages of `command` and `odom`.

@@ -1,15 +1,14 @@
 #pragma once
 
 #include <cstdint>
-#include <deque>
 #include <mutex>
 #include <string>
-#include <utility>
 
 #include <ros/ros.h>
 
 #include "projection_collision_avoidance/LeaderBroadcast.h"
 #include "projection_collision_avoidance/ros/InputAdmission.hpp"
+#include "projection_collision_avoidance/sim/ReleaseQueue.hpp"
 #include "projection_collision_avoidance/sim/SharedLink.hpp"
 
 namespace projection_collision_avoidance {
@@ -20,6 +19,11 @@ struct LinkRelayOptions {
   double control_rate = 0;  ///< Hz, controller.control_rate of ~scenario
   int receiver = 1;         ///< ~receiver: index of the follower behind the relay (the losses' key)
   int max_in_flight = 10000;  ///< ~max_in_flight: messages held at most; the oldest go first
+  /// ~max_in_flight_bytes: bytes held at most (serialised sizes); the oldest go first
+  int max_in_flight_bytes = 16 * 1024 * 1024;
+  /// ~max_future_stamp (s): a message stamped further ahead of ROS time is refused (two 100 ms
+  /// bursts of a simulated /clock and 50 ms of transport, as the other nodes; doc/boundary.md)
+  double max_future_stamp = 0.25;
 };
 
 /// A simulated network link between a target's `broadcast` and the follower that looks at it, for
@@ -29,8 +33,12 @@ struct LinkRelayOptions {
 /// Subscribes `input` (LeaderBroadcast) and publishes each message unchanged, stamp included, on
 /// `output`: lost with the scenario's dropout (by receiver and the sender's tick round(stamp f)),
 /// otherwise when ROS time reaches stamp + D / f, D = delay_periods + ceil(latency f), checked
-/// by a timer at f. Without a link section (or an ideal one) every message passes at once. When
-/// ROS time goes back the messages in flight are dropped. Not part of a vehicle's control path.
+/// by a timer at f, each in the order of its release (a later message due earlier is not held
+/// behind one due later; ties in arrival order). Without a link section (or an ideal one) every
+/// message passes at once. A message stamped more than max_future_stamp ahead of ROS time is
+/// refused; the messages held are bounded in count and bytes, the oldest dropped first; each is
+/// counted. When ROS time goes back the messages in flight are dropped. Not part of a vehicle's
+/// control path.
 class LinkRelay {
  public:
   /// @throws ParameterError naming the key of a refused parameter
@@ -49,12 +57,13 @@ class LinkRelay {
   LinkRelayOptions options_;
   int delay_periods_ = 0;  ///< D
   std::mutex mutex_;
-  std::deque<std::pair<double, LeaderBroadcast::ConstPtr>> in_flight_;  ///< (release s, message)
+  ReleaseQueue<LeaderBroadcast::ConstPtr> in_flight_;  ///< by release time (s)
   TimeJumpWatch clock_;
   std::uint64_t received_ = 0;
   std::uint64_t lost_ = 0;
   std::uint64_t passed_ = 0;
-  std::uint64_t overflowed_ = 0;
+  std::uint64_t overflowed_ = 0;     ///< dropped (the oldest) or refused (too large) when full
+  std::uint64_t future_stamps_ = 0;  ///< refused: stamped beyond max_future_stamp
   ros::Publisher publisher_;
   ros::Subscriber subscriber_;
   ros::Timer timer_;

@@ -40,7 +40,13 @@ struct ConvertedCommand {
   bool speed_limited = false;  ///< the velocity was scaled onto max_speed
   bool heading_known = true;   ///< false: no fresh own odometry for a base-frame or unicycle map
   bool stop = false;           ///< this is the stop of each kind
+  /// The conversion gave a non-finite value (an overflow of huge finite inputs): this is the
+  /// stop in its place.
+  bool replaced_non_finite = false;
 };
+
+/// Whether every value a vehicle would be sent (acceleration, velocity, (v, ω)) is finite.
+bool isFinite(const ConvertedCommand& command);
 
 /// Converts the follower's commands, one per control period, with the vehicle's own odometry:
 /// - acceleration: a as it is;
@@ -51,7 +57,9 @@ struct ConvertedCommand {
 ///   look-ahead map with the limits (UnicycleLookAhead::command()); the integrator is told what
 ///   was sent (s ṗ_l).
 /// A base-frame velocity or a unicycle command needs the heading: without a fresh own odometry
-/// the converter sends the stop and says heading_known = false. Never throws on inputs;
+/// the converter sends the stop and says heading_known = false. A conversion that is not finite
+/// (huge finite inputs whose products overflow) gives the stop instead, with
+/// replaced_non_finite = true: every command given is finite. Never throws on inputs;
 /// allocates nothing.
 class CommandConverter {
  public:
@@ -70,7 +78,7 @@ class CommandConverter {
                                   double now);
 
   /// Each kind's stop at @p now (s): zero velocity, zero (v, ω), and for the acceleration a
-  /// braking one; the integrator starts again from rest.
+  /// braking one (zero if that is not finite); the integrator starts again from rest.
   const ConvertedCommand& stop(double now);
 
   const CommandConverterOptions& options() const { return options_; }

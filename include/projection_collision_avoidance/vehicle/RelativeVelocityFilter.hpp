@@ -19,6 +19,13 @@ struct VelocityFilterOptions {
   double bandwidth = 20.0;
   /// Δt (s) beyond which the filter starts again from the next two positions, > 0.
   double max_gap = 0.5;
+  /// Δt (s), > 0, below which a position is not used: closer than this to the last position
+  /// used, its difference from it is mostly the sensor's noise (1 cm over 5 ms is 2 m/s) or a
+  /// glitch's (a repeated sample, a burst). 0.005 s passes every sensor up to 200 Hz.
+  double min_interval = 0.005;
+  /// Largest relative speed (m/s, > 0) a vehicle pair can have: an estimate beyond it is refused
+  /// and the filter starts again from that position.
+  double max_speed = 50.0;
 };
 
 /// What became of one relative position.
@@ -26,10 +33,12 @@ enum class VelocityFilterVerdict {
   kEstimated,      ///< velocity estimated: state valid
   kStarted,        ///< the first position (or the first after a gap): no velocity yet
   kNotIncreasing,  ///< stamp not after the previous one: ignored
+  kTooSoon,        ///< less than min_interval after the last position used: ignored
+  kTooFast,        ///< an estimate beyond max_speed: not given, the filter started from it
   kRefused,        ///< a non-finite position or stamp, or a wrong size: ignored
 };
 
-/// "estimated", "started", "stamp not increasing", "refused".
+/// "estimated", "started", "stamp not increasing", "too soon", "too fast", "refused".
 const char* toString(VelocityFilterVerdict verdict);
 
 /// A critically damped α-β filter on a constant-velocity model of the relative position p
@@ -39,15 +48,18 @@ const char* toString(VelocityFilterVerdict verdict);
 /// whose error dynamics have the double pole θ: the discrete counterpart of the observer
 /// ė = [[−2ω, 1], [−ω², 0]] e. The second position starts v̂ as a difference quotient. Under a
 /// constant relative acceleration a the velocity lags by a Δt ((1 + θ)/(1 − θ) − ½) ≈ 2a/ω.
-/// Never throws on inputs.
+/// A position less than min_interval after the last one used is ignored (kTooSoon), and an
+/// estimate faster than max_speed is never given (kTooFast): so no velocity above max_speed
+/// ever leaves the filter. Never throws on inputs.
 class RelativeVelocityFilter {
  public:
-  /// @throws std::invalid_argument naming the option (axes, bandwidth, max_gap) out of range
+  /// @throws std::invalid_argument naming the option (axes, bandwidth, max_gap, min_interval,
+  ///         max_speed) out of range
   explicit RelativeVelocityFilter(const VelocityFilterOptions& options);
 
   /// Takes the relative position @p position (m, the first axes() entries) measured at @p t (s);
   /// on kEstimated, @p state = [p; v̂] (2·axes entries: the position as measured, the velocity
-  /// estimated, m and m/s).
+  /// estimated, m and m/s, ‖v̂‖ ≤ max_speed).
   VelocityFilterVerdict update(double t, const Eigen::Vector3d& position, Eigen::VectorXd* state);
 
   /// Forgets everything: the next position starts again.

@@ -211,6 +211,12 @@ void CommandAdapter::diagnose(diagnostic_updater::DiagnosticStatusWrapper& statu
   status.add("rejected_odometry", odometry_timeline_.rejected());
   status.add("superseded_odometry", odometry_timeline_.superseded());
   status.add("max_future_stamp (s)", options_->max_future_stamp);
+  status.add("non_finite_outputs_replaced_by_stop", replaced_outputs_);
+  status.add("non_finite_outputs_not_published", unpublished_outputs_);
+  if (replaced_outputs_ + unpublished_outputs_ > 0) {
+    status.mergeSummary(DiagnosticStatus::WARN,
+                        "non-finite conversions (overflowing inputs) replaced by the stop");
+  }
   // How the vehicle follows the velocity commands (VehicleResponseEstimator, doc/vehicles.md).
   const VehicleResponse& response = converter_.response();
   status.add("vehicle_update_interval (s)", response.update_interval);
@@ -228,6 +234,16 @@ void CommandAdapter::diagnose(diagnostic_updater::DiagnosticStatusWrapper& statu
 }
 
 void CommandAdapter::publish(const ConvertedCommand& command, const ros::Time& stamp) {
+  if (command.replaced_non_finite) {
+    ++replaced_outputs_;
+    ROS_WARN_STREAM_THROTTLE(5.0, name_ << ": a command converted into non-finite values (an "
+                                           "overflow of huge inputs): sending the stop instead");
+  }
+  if (!isFinite(command)) {  // the converter never gives one: nothing leaves unchecked
+    ++unpublished_outputs_;
+    ROS_ERROR_STREAM_THROTTLE(5.0, name_ << ": a non-finite command not published");
+    return;
+  }
   if (options_->accel_enu) {
     geometry_msgs::Vector3Stamped accel;
     accel.header.stamp = stamp;

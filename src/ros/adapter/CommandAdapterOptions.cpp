@@ -1,6 +1,5 @@
 #include "adapter/CommandAdapterOptions.hpp"
 
-#include <limits>
 #include <sstream>
 
 #include "projection_collision_avoidance/core/ParameterError.hpp"
@@ -8,13 +7,17 @@
 namespace projection_collision_avoidance {
 namespace {
 
-constexpr double kInfinity = std::numeric_limits<double>::infinity();
 constexpr double kDefaultOdometryAge = 0.25;  ///< s, ~odometry/max_age
+/// m/s, ~velocity/max_speed and ~unicycle/max_speed: launch/vehicles.launch's limit; the
+/// robots of test/enki set their own, lower ones.
+constexpr double kDefaultMaxSpeed = 4.0;
+/// rad/s, ~unicycle/max_yaw_rate: launch/vehicles.launch's limit.
+constexpr double kDefaultMaxYawRate = 3.0;
+constexpr double kLargestLimit = 1e4;  ///< m/s or rad/s
 
-/// A limit where 0 means none (infinity).
-double limitOrNone(NodeOptionReader& reader, const std::string& key, double max) {
-  const double value = reader.number(key, 0.0, 0.0, max);
-  return value > 0.0 ? value : kInfinity;
+/// A limit of the outputs, > 0 and finite.
+double limit(NodeOptionReader& reader, const std::string& key, double fallback) {
+  return reader.number(key, fallback, 1e-6, kLargestLimit);
 }
 
 /// "body" or "header" (~odometry/twist_frame).
@@ -77,7 +80,7 @@ CommandAdapterOptions readCommandAdapterOptions(NodeOptionReader& reader) {
   // next (doc/boundary.md).
   c.max_odometry_age = reader.number("odometry/max_age", kDefaultOdometryAge, 0.0, 3600.0);
   c.odometry_twist_frame = twistFrameOf(reader.text("odometry/twist_frame", "body"));
-  c.velocity.max_speed = limitOrNone(reader, "velocity/max_speed", 1e4);
+  c.velocity.max_speed = limit(reader, "velocity/max_speed", kDefaultMaxSpeed);
   c.velocity.velocity_lag = reader.number("velocity/lag", 0.0, 0.0, 3600.0);
   c.velocity.max_measurement_age = c.max_odometry_age;
   // The response delay: < 0 estimated from the odometry against the commands sent.
@@ -97,8 +100,8 @@ CommandAdapterOptions readCommandAdapterOptions(NodeOptionReader& reader) {
         "~axes", "is " + std::to_string(c.axes) + " but the unicycle output is planar: set 2");
   }
   c.look_ahead = reader.number("unicycle/look_ahead", c.look_ahead, 1e-3, 100.0);
-  c.unicycle_limits.max_speed = limitOrNone(reader, "unicycle/max_speed", 1e4);
-  c.unicycle_limits.max_yaw_rate = limitOrNone(reader, "unicycle/max_yaw_rate", 1e4);
+  c.unicycle_limits.max_speed = limit(reader, "unicycle/max_speed", kDefaultMaxSpeed);
+  c.unicycle_limits.max_yaw_rate = limit(reader, "unicycle/max_yaw_rate", kDefaultMaxYawRate);
   c.stop_deceleration = reader.number("stop_deceleration", c.stop_deceleration, 1e-3, 1e3);
   options.base_frame = reader.frame("base_frame", "");
   options.world_frame = reader.frame("world_frame", "");

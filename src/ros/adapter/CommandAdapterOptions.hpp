@@ -32,7 +32,8 @@ struct CommandAdapterOptions {
 /// ~odometry/max_age, ~odometry/twist_frame, ~odometry/pose_frame ("world" needs ~world_frame),
 /// ~velocity/max_speed, ~velocity/lag, ~velocity/delay, ~velocity/max_delay,
 /// ~velocity/averaging_time, ~velocity/frame, ~unicycle/look_ahead, ~unicycle/max_speed,
-/// ~unicycle/max_yaw_rate, ~stop_deceleration, ~base_frame, ~world_frame.
+/// ~unicycle/max_yaw_rate, ~stop_deceleration, ~base_frame, ~world_frame. The speed and yaw-rate
+/// limits are finite (4 m/s, 3 rad/s by default; at most 1e4): every output is within them.
 CommandAdapterOptions readCommandAdapterOptions(NodeOptionReader& reader);
 
 }  // namespace projection_collision_avoidance

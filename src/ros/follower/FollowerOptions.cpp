@@ -94,6 +94,13 @@ PositionInputOptions readPositionOptions(NodeOptionReader& reader, MeasurementIn
   o.velocity_bandwidth =
       reader.number("position/velocity_bandwidth", o.velocity_bandwidth, 1e-3, 1e4);
   o.max_gap = reader.number("position/max_gap", measurement_timeout, 1e-6, 3600.0);
+  o.min_interval = reader.number("position/min_interval", o.min_interval, 1e-6, 3600.0);
+  if (!(o.min_interval < o.max_gap)) {
+    throw ParameterError("~position/min_interval", "must be below ~position/max_gap (" +
+                                                       std::to_string(o.max_gap) +
+                                                       " s), or no position is ever used");
+  }
+  o.max_speed = reader.number("position/max_speed", o.max_speed, 1e-3, 1e6);
   o.tf_timeout = reader.number("position/tf_timeout", o.tf_timeout, 0.0, 10.0);
   if (input != MeasurementInput::kTf) {
     return o;

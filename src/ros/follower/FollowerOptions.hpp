@@ -69,7 +69,9 @@ struct OdometryInputOptions {
 struct PositionInputOptions {
   double velocity_bandwidth = 20.0;  ///< rad/s; ω of the relative velocity filter
   double max_gap = 0.5;              ///< s; a longer gap between positions restarts the filter
-  double tf_timeout = 0.0;           ///< s a tf lookup of a position's frame may wait
+  double min_interval = 0.005;  ///< s; a position closer to the last used is ignored (< max_gap)
+  double max_speed = 50.0;      ///< m/s; a faster relative velocity estimate is refused
+  double tf_timeout = 0.0;      ///< s a tf lookup of a position's frame may wait
   // ~input tf only:
   std::string self_frame;          ///< the follower's body frame (~tf/self_frame)
   std::string target_frame;        ///< its target's body frame (~tf/target_frame)

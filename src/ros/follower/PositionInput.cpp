@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <string>
 #include <utility>
 
 #include <Eigen/Geometry>
@@ -21,10 +22,17 @@ RelativeVelocityFilter makeFilter(const PositionInputOptions& o, int axes) {
   f.axes = axes;
   f.bandwidth = o.velocity_bandwidth;
   f.max_gap = o.max_gap;
+  f.min_interval = o.min_interval;
+  f.max_speed = o.max_speed;
   try {
     return RelativeVelocityFilter(f);
   } catch (const std::invalid_argument& error) {
-    throw ParameterError("~position/velocity_bandwidth", error.what());
+    // The message begins with the option's name.
+    const std::string what = error.what();
+    const std::string option = what.substr(0, what.find(' '));
+    throw ParameterError(
+        "~position/" + (option == "bandwidth" ? std::string("velocity_bandwidth") : option),
+        error.what());
   }
 }
 
@@ -194,12 +202,16 @@ bool PositionInput::filter(const ros::Time& stamp, const std::string& frame,
                            const Eigen::Vector3d& p, std::string* why) {
   const VelocityFilterVerdict verdict = filter_.update(stamp.toSec(), p, &state_);
   if (verdict == VelocityFilterVerdict::kRefused ||
-      verdict == VelocityFilterVerdict::kNotIncreasing) {
-    *why = std::string("the velocity filter refused the position: ") + toString(verdict);
+      verdict == VelocityFilterVerdict::kNotIncreasing ||
+      verdict == VelocityFilterVerdict::kTooFast) {
+    *why = std::string("the velocity filter refused the position: ") + toString(verdict) +
+           (verdict == VelocityFilterVerdict::kTooFast ? " (beyond ~position/max_speed)" : "");
     return false;
   }
   if (verdict != VelocityFilterVerdict::kEstimated) {
-    return true;  // the first position: no velocity yet
+    // The first position (no velocity yet), or one too soon after the last used: not a fault
+    // of the sender (a sensor faster than ~position/min_interval), simply not used.
+    return true;
   }
   measurement_.header.stamp = stamp;
   measurement_.header.frame_id = frame;
