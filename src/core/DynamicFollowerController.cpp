@@ -64,6 +64,7 @@ const DynamicFollowerStatus& DynamicFollowerController::step(const DynamicStepIn
   return visitStep([&](auto& controller) -> const auto& {
     using C = std::decay_t<decltype(controller)>;
     StepInputs<typename C::Dimensions> converted;
+    converted.period_fraction = inputs.period_fraction;
     if (inputs.measurement) {
       converted.measurement = as<typename C::OutputVector>(*inputs.measurement);
     }

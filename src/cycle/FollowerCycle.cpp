@@ -1,5 +1,6 @@
 #include "projection_collision_avoidance/cycle/FollowerCycle.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -35,7 +36,8 @@ FollowerCycle::FollowerCycle(std::unique_ptr<DynamicFollowerController> controll
       separation_(separation),
       settings_(settings),
       period_(handover_.current().design().period),
-      stall_wait_(settings.measurement_timeout, period_) {
+      stall_wait_(settings.measurement_timeout, period_),
+      pacer_(period_) {
   if (separation.size() != handover_.current().stateDimension()) {
     throw std::invalid_argument("FollowerCycle: a controller and d of its state's size");
   }
@@ -79,6 +81,12 @@ bool FollowerCycle::stepOnLatchedMeasurement(std::int64_t now_ns, std::uint32_t 
   }
   addSaturated(&missed_periods_, skipped);
   const MeasurementSample& m = inputs_.measurement();
+  if (!pacer_.admit(m.stamp_ns)) {  // too soon after the step before: latched for the next
+    addSaturated(&held_measurements_, 1);
+    out->stepped = false;
+    fillCounters(now_ns, out);
+    return false;
+  }
   return step(now_ns, m.stamp_ns, kNanosecond * static_cast<double>(now_ns - m.stamp_ns), out);
 }
 
@@ -114,7 +122,15 @@ bool FollowerCycle::step(std::int64_t now_ns, std::int64_t stamp_ns, double dela
   // the paper's constant spacing.
   out->own_state_fresh = design.parameters.time_headway > 0.0 &&
                          inputs_.ownStateAge(stamp_ns) <= settings_.measurement_timeout;
+  // No two commands carry one stamp; under the measurement trigger the rate limit allows the
+  // change of the time since the step before (their stamps), a period at most.
+  const std::int64_t stamp =
+      have_stamp_ && stamp_ns <= last_stamp_ns_ ? last_stamp_ns_ + 1 : stamp_ns;
   DynamicStepInputs inputs;  // without a measurement the step runs the fallback
+  if (settings_.measurement_trigger && have_stamp_) {
+    inputs.period_fraction =
+        std::min(1.0, kNanosecond * static_cast<double>(stamp - last_stamp_ns_) / period_);
+  }
   if (mode_ != FollowerMode::kMeasurementLost) {
     y_.noalias() = design.parameters.model.C * out->xi;
     inputs.measurement.emplace(y_);
@@ -127,8 +143,8 @@ bool FollowerCycle::step(std::int64_t now_ns, std::int64_t stamp_ns, double dela
   }
   const DynamicFollowerStatus* status = &controller.step(inputs);
   out->stepped = true;
-  out->stamp_ns = have_stamp_ && stamp_ns <= last_stamp_ns_ ? last_stamp_ns_ + 1 : stamp_ns;
-  last_stamp_ns_ = out->stamp_ns;
+  out->stamp_ns = stamp;
+  last_stamp_ns_ = stamp;
   have_stamp_ = true;
   out->steps = steps_;
   out->measurement_age = ages.measurement_age;
@@ -142,6 +158,7 @@ void FollowerCycle::noteTime(std::int64_t now_ns) {
   // Counted and reported (time_jump) by fillCounters(); a new timeline's stamps start afresh.
   if (time_.wentBack(now_ns)) {
     have_stamp_ = false;
+    pacer_.reset();
   }
 }
 
@@ -150,6 +167,7 @@ void FollowerCycle::fillCounters(std::int64_t now_ns, FollowerCycleOutput* out) 
   out->mode = mode_;
   out->missed_periods = missed_periods_;
   out->late_periods = late_periods_;
+  out->held_measurements = held_measurements_;
   out->tick_delay = tick_delay_;
   out->time_jumps = time_.jumps();
   out->time_jump = time_.jump();

@@ -105,6 +105,84 @@ TEST(CommandRateLimiter, LimitsTheChangeInsideTheBall) {
   EXPECT_GT(limited, 1000);
 }
 
+TEST(CommandRateLimiter, AStepLessThanAPeriodAfterTheLastChangesByTheJerkLimitTimesItsTime) {
+  std::mt19937 rng(11);
+  const double radius = 2.0;
+  CommandRateLimiter<Vector2> limiter(30.0, 0.01, radius, 2);  // r T = 0.3 m/s^2
+  std::uniform_real_distribution<double> fraction_of(0.0, 1.0);
+  int limited = 0;
+  for (int k = 0; k < 2000; ++k) {
+    const Vector2 previous = limiter.previous();
+    Vector2 target = testing::randomVector(rng, 2, 1.5);
+    clampNorm(target, radius);
+    Vector2 command = target;
+    const double fraction = fraction_of(rng);  // Delta t = fraction T
+    const double allowed = 30.0 * 0.01 * fraction;
+    ASSERT_EQ(limiter.maxChange(fraction), allowed);
+    if (limiter.limit(command, fraction)) {
+      ++limited;
+      ASSERT_NEAR(euclideanNorm(command - previous), allowed, 1e-12) << k;
+    } else {
+      ASSERT_EQ(command, target) << k;
+    }
+    ASSERT_LE(euclideanNorm(command - previous), allowed) << k;
+    ASSERT_LE(euclideanNorm(command), radius) << k;
+  }
+  EXPECT_GT(limited, 1000);
+  // A whole period or more: r T, bit for bit the limit without a fraction.
+  CommandRateLimiter<Vector2> whole(30.0, 0.01, radius, 2);
+  CommandRateLimiter<Vector2> late(30.0, 0.01, radius, 2);
+  Vector2 a(1.5, -1.0);
+  Vector2 b = a;
+  Vector2 c = a;
+  whole.limit(a);
+  late.limit(b, 1.0);
+  EXPECT_EQ(a, b);
+  late.reset();
+  late.limit(c, 7.0);  // two periods late: still r T
+  EXPECT_EQ(a, c);
+  EXPECT_EQ(whole.maxChange(1.0), whole.maxChange());
+  // No time, a negative or a NaN fraction: the command is held.
+  for (const double none : {0.0, -0.5, std::nan("")}) {
+    Vector2 held(-1.0, 1.0);
+    EXPECT_TRUE(whole.limit(held, none)) << none;
+    EXPECT_EQ(held, a) << none;
+    EXPECT_EQ(whole.maxChange(none), 0.0) << none;
+  }
+}
+
+TEST(CommandRateLimit, TheControllerLimitsTheChangeToTheStepsFraction) {
+  // In tracking and in the fallback, ||u(k) - u(k-1)|| <= r T f for each step's fraction f.
+  const double jerk_limit = 20.0;
+  const ControllerDesign design = ControllerDesign::create(planarParameters(jerk_limit, 5.0));
+  DynamicFollowerController controller(design);
+  DynamicFollowerController whole(design);  // f = 1 given explicitly
+  DynamicFollowerController plain(design);  // f left at its default
+  JumpingMeasurement measurement;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> fraction_of(0.05, 1.0);
+  Eigen::VectorXd previous = Eigen::VectorXd::Zero(2);
+  int limited = 0;
+  for (int k = 0; k < 1000; ++k) {
+    const Eigen::VectorXd y = measurement.next(k);
+    DynamicStepInputs inputs;
+    if (k % 100 < 70) {
+      inputs.measurement.emplace(y);
+    }
+    const DynamicStepInputs defaults = inputs;
+    inputs.period_fraction = fraction_of(rng);
+    const DynamicFollowerStatus& s = controller.step(inputs);
+    ASSERT_LE(euclideanNorm(s.command - previous),
+              jerk_limit * design.period * inputs.period_fraction)
+        << k;
+    limited += s.command_rate_limited ? 1 : 0;
+    previous = s.command;
+    inputs.period_fraction = 1.0;
+    ASSERT_EQ(whole.step(inputs).command, plain.step(defaults).command) << k;
+  }
+  EXPECT_GT(limited, 100);
+}
+
 TEST(CommandRateLimiter, OverflowingChangeAndOutsidePreviousStayBounded) {
   const double huge = 0.9 * std::numeric_limits<double>::max();
   CommandRateLimiter<Vector2> limiter(1e307, 1.0, kInf, 2);

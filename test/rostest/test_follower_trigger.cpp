@@ -1,6 +1,6 @@
 /// rostest: a follower with ~trigger measurement (test/rostest/follower_trigger.test). Parameters
 /// of the test node:
-///   ~measurements         how many measurements to publish, one at a time
+///   ~measurements         how many measurements to publish, one at a time, a period apart
 ///   ~control_rate         the follower's control rate (Hz)
 ///   ~measurement_timeout  the follower's ~measurement_timeout (s)
 ///   ~fallback_ticks       timer steps to see once the measurement is stale
@@ -36,14 +36,21 @@ class FollowerTriggerTest : public testing::FollowerTest {
     publisher_ = nh_.advertise<RelativeMeasurement>("/follower/relative_measurement", 100);
   }
 
-  /// Waits until the follower hears this node and this node hears the follower.
+  /// Waits until the follower hears this node and this node hears the follower, and then a
+  /// control period, so that the first measurement of a test is a period after those of the
+  /// test before (a measurement sooner is held).
   bool connected() {
-    return waitFor(
-        [this] {
-          return publisher_.getNumSubscribers() > 0 && command_subscriber_.getNumPublishers() > 0 &&
-                 status_subscriber_.getNumPublishers() > 0;
-        },
-        param("wall_deadline"));
+    if (!waitFor(
+            [this] {
+              return publisher_.getNumSubscribers() > 0 &&
+                     command_subscriber_.getNumPublishers() > 0 &&
+                     status_subscriber_.getNumPublishers() > 0;
+            },
+            param("wall_deadline"))) {
+      return false;
+    }
+    const ros::Time settled = ros::Time::now() + ros::Duration(1.0 / param("control_rate"));
+    return waitFor([settled] { return ros::Time::now() >= settled; }, param("wall_deadline"));
   }
 
   /// Publishes one valid measurement stamped now; returns the stamp.
@@ -91,9 +98,15 @@ TEST_F(FollowerTriggerTest, EachMeasurementRunsOneStepStampedWithIt) {
   ASSERT_TRUE(connected()) << "the follower and the test never connected";
   const int n = static_cast<int>(param("measurements"));
   const double deadline = param("wall_deadline");
+  const ros::Duration period(1.0 / param("control_rate"));
   std::vector<ros::Time> stamps;
-  // One at a time: the next once the command answering this one (and its status) arrived.
+  // One at a time: the next once the command answering this one (and its status) arrived, and a
+  // control period after it (a measurement sooner would be held: doc/boundary.md, Time).
   for (int i = 0; i < n; ++i) {
+    if (!stamps.empty()) {
+      const ros::Time due = stamps.back() + period;
+      ASSERT_TRUE(waitFor([due] { return ros::Time::now() >= due; }, deadline));
+    }
     const ros::Time stamp = publishMeasurement();
     stamps.push_back(stamp);
     ASSERT_TRUE(waitFor(

@@ -11,6 +11,8 @@ namespace projection_collision_avoidance {
 
 /// Rate limit u(k) = u(k-1) + clamp(u* - u(k-1), r T): ||u(k) - u(k-1)|| <= r T (r in m/s^3,
 /// T in s, u in m/s^2 for double integrators), as ros_controllers' SpeedLimiter limits a speed.
+/// A step that comes less than a period after the previous one (Delta t = f T, f < 1) may change
+/// the command by r T f = r Delta t only, so that the limit holds per second, not per step.
 ///
 /// The limited command lies on the segment from the previous command u(k-1) to the target u*.
 /// When both are in the ball ||u|| <= a (the saturation), so is the segment, the ball being
@@ -29,16 +31,20 @@ class CommandRateLimiter {
       : max_change_(jerk_limit * period), radius_(radius), previous_(Vector::Zero(size)) {}
 
   /// Limits the finite @p command (with euclideanNorm(command) <= radius) in place to the ball
-  /// of radius r T around the previous command, and makes the result the previous command.
+  /// of radius r T f around the previous command, and makes the result the previous command.
+  /// @param fraction f, the part of a period T since the previous command (Delta t / T, so that
+  ///        the change is at most r Delta t): 1 or more (the default) allows r T, exactly the
+  ///        limit of a whole period; 0, less, or NaN allows no change (the command is held)
   /// @return true if the command was changed
-  bool limit(Vector& command) {
+  bool limit(Vector& command, double fraction = 1.0) {
     if (!(max_change_ < std::numeric_limits<double>::infinity())) {
       previous_ = command;
       return false;
     }
+    const double max_change = maxChange(fraction);
     Vector change = command - previous_;
     if (change.allFinite()) {
-      if (!(clampNorm(change, max_change_) > 0.0)) {
+      if (!(clampNorm(change, max_change) > 0.0)) {
         previous_ = command;
         return false;
       }
@@ -46,13 +52,13 @@ class CommandRateLimiter {
       change = 0.5 * command - 0.5 * previous_;
       change /= change.cwiseAbs().maxCoeff();
       change /= euclideanNorm(change);
-      change *= max_change_;
+      change *= max_change;
     }
     command = previous_ + change;
     // Rounding can leave the sum an ulp or so outside either ball: shorten the change by a
     // factor whose distance from 1 doubles each time. A zero change gives u(k-1), inside both.
     double shrink = 2.0 * std::numeric_limits<double>::epsilon();
-    while (!command.allFinite() || euclideanNorm(command - previous_) > max_change_ ||
+    while (!command.allFinite() || euclideanNorm(command - previous_) > max_change ||
            euclideanNorm(command) > radius_) {
       change *= 1.0 - shrink;
       shrink = std::min(2.0 * shrink, 0.5);
@@ -80,6 +86,15 @@ class CommandRateLimiter {
 
   /// r T, the largest change per period (m/s^2 for double integrators); infinity: no limit.
   double maxChange() const { return max_change_; }
+
+  /// r T f, the largest change limit() allows for the fraction @p fraction of a period (as
+  /// limit() reads it: at most r T, 0 for f <= 0 or NaN); infinity: no limit.
+  double maxChange(double fraction) const {
+    if (fraction >= 1.0) {
+      return max_change_;
+    }
+    return fraction > 0.0 ? max_change_ * fraction : 0.0;
+  }
 
  private:
   double max_change_;

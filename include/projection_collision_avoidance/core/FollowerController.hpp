@@ -29,11 +29,12 @@ namespace projection_collision_avoidance {
 /// command. A step allocates no memory.
 ///
 /// Whatever the inputs, after every call the command is finite with euclideanNorm(u_2) <=
-/// acceleration_limit and euclideanNorm(u_2 - u_2 of the previous call) <= jerk_limit T, and
-/// the estimate is finite with euclideanNorm(xi_hat) <= xi_max: a
-/// non-finite measurement is treated as missing, a non-finite u_1 as unknown, a command that
-/// overflows is replaced by a finite one, and an estimator substep that overflows is discarded;
-/// each is flagged in the status.
+/// acceleration_limit and euclideanNorm(u_2 - u_2 of the previous call) <= jerk_limit T f (f =
+/// StepInputs::period_fraction, at most 1: the limit per second of a step less than T after the
+/// previous one), and the estimate is finite with euclideanNorm(xi_hat) <= xi_max: a non-finite
+/// measurement is treated as missing, a non-finite u_1 as unknown, a command that overflows is
+/// replaced by a finite one, and an estimator substep that overflows is discarded; each is
+/// flagged in the status.
 template <typename Dims>
 class FollowerController {
  public:
@@ -88,6 +89,7 @@ class FollowerController {
   /// @return the status of this tick; status.command is u_2 (m/s^2 for double integrators)
   const FollowerControllerStatus<Dims>& step(const StepInputs<Dims>& inputs) {
     const bool leader_input_known = inputs.leader_input.has_value();
+    period_fraction_ = inputs.period_fraction;
     return tick(inputs.measurement ? &*inputs.measurement : nullptr,
                 leader_input_known ? *inputs.leader_input : InputVector::Zero(input_matrix_.cols()),
                 leader_input_known, inputs.own_state ? &*inputs.own_state : nullptr);
@@ -195,7 +197,7 @@ class FollowerController {
     status_.constraint_value = estimator_.constraint().value(estimate);
     status_.fallback_command.setZero();
     status_.fallback = false;
-    status_.command_rate_limited = rate_limiter_.limit(status_.command);
+    status_.command_rate_limited = rate_limiter_.limit(status_.command, period_fraction_);
     const InputVector acting = law_.acting(terms_, status_.command, status_.feedforward_command,
                                            status_.command_rate_limited);
     const EstimatorPeriodReport report =
@@ -262,7 +264,7 @@ class FollowerController {
   void limitCommand() {
     status_.command_saturated =
         saturateCommand(&status_.command, design_.parameters.acceleration_limit);
-    status_.command_rate_limited = rate_limiter_.limit(status_.command);
+    status_.command_rate_limited = rate_limiter_.limit(status_.command, period_fraction_);
   }
 
   ControllerDesign design_;
@@ -276,6 +278,7 @@ class FollowerController {
   FeedforwardFilter<InputVector> feedforward_filter_;       // (S2)
   CommandRateLimiter<InputVector> rate_limiter_;            // jerk_limit, from u_2(k-1)
   FollowerControllerStatus<Dims> status_;
+  double period_fraction_ = 1.0;  // of this step (StepInputs::period_fraction)
   bool initialized_ = false;
 };
 

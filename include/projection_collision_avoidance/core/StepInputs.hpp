@@ -19,6 +19,10 @@ struct StepInputs {
   std::optional<typename Dims::InputVector> leader_input{};
   /// The follower's own state x_2 (m, m/s), for the time headway (S1); absent: it does not act.
   std::optional<typename Dims::StateVector> own_state{};
+  /// Delta t / T: the part of a control period T since the previous step's command, which the
+  /// rate limit scales its allowed change by (jerk_limit Delta t; CommandRateLimiter::limit());
+  /// 1 (the default): a whole period.
+  double period_fraction = 1.0;
 };
 
 /// StepInputs of any sizes, the argument of DynamicFollowerController::step(): each entry a
@@ -27,6 +31,7 @@ struct DynamicStepInputs {
   std::optional<Eigen::Ref<const Eigen::VectorXd>> measurement{};   ///< y (m, m/s)
   std::optional<Eigen::Ref<const Eigen::VectorXd>> leader_input{};  ///< a_1 (m/s^2)
   std::optional<Eigen::Ref<const Eigen::VectorXd>> own_state{};     ///< x_2 (m, m/s)
+  double period_fraction = 1.0;  ///< Delta t / T since the previous step (StepInputs)
 };
 
 }  // namespace projection_collision_avoidance

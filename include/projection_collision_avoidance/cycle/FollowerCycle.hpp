@@ -15,6 +15,7 @@
 #include "projection_collision_avoidance/cycle/InputTimeline.hpp"
 #include "projection_collision_avoidance/cycle/LatchedInputs.hpp"
 #include "projection_collision_avoidance/cycle/StallWait.hpp"
+#include "projection_collision_avoidance/cycle/StepPacer.hpp"
 #include "projection_collision_avoidance/cycle/TimeJumpWatch.hpp"
 #include "projection_collision_avoidance/rt/LatestValue.hpp"
 #include "projection_collision_avoidance/rt/PeriodicThread.hpp"
@@ -30,7 +31,8 @@ struct FollowerCycleSettings {
   double measurement_timeout = 0.5;  ///< s: an older measurement is stale
   double leader_timeout = 0.5;       ///< s: an older leader broadcast is stale
   bool use_leader_input = false;     ///< give the controller a fresh leader acceleration
-  bool measurement_trigger = false;  ///< steps answer measurements; ticks only brake
+  bool measurement_trigger = false;  ///< steps answer measurements (paced: StepPacer); ticks
+                                     ///< only brake
 };
 
 /// What a tick or step gives the outputs: the step's results when one ran, and the counters.
@@ -64,6 +66,9 @@ struct FollowerCycleOutput {
   double time_headway = 0.0;        ///< h in force (s); 0: constant spacing
   std::uint32_t missed_periods = 0;
   std::uint32_t late_periods = 0;
+  /// measurement trigger: accepted measurements that ran no step since start, each too soon
+  /// after the step before (StepPacer); the next step uses the latest
+  std::uint32_t held_measurements = 0;
   double tick_delay = 0.0;       ///< s, of the latest step
   std::uint32_t time_jumps = 0;  ///< jumps back of ROS time since start
   double time_jump = 0.0;        ///< s (negative): the jump seen at this tick, else 0
@@ -149,7 +154,11 @@ class FollowerCycle {
 
   /// The step answering the measurement just written to measurement() (measurement trigger),
   /// stamped with its stamp, at the ROS time @p ros_now gives (ns) once the inputs are latched;
-  /// @p skipped periods since the one before.
+  /// @p skipped periods since the one before. Paced by the measurements' stamps (StepPacer): one
+  /// that comes too soon after the step before runs none (held_measurements), and the next step
+  /// uses the latest measurement. A step Delta t < T after the step before (their stamps) may
+  /// change the command by jerk_limit Delta t only (StepInputs::period_fraction).
+  /// @return whether @p out got a step
   template <typename RosNow,
             typename = std::enable_if_t<std::is_invocable_r_v<std::int64_t, RosNow&>>>
   bool stepOnMeasurement(RosNow&& ros_now, std::uint32_t skipped, FollowerCycleOutput* out) {
@@ -209,6 +218,8 @@ class FollowerCycle {
   bool have_stamp_ = false;         ///< a step ran on this timeline
   std::uint32_t missed_periods_ = 0;
   std::uint32_t late_periods_ = 0;
+  std::uint32_t held_measurements_ = 0;
+  StepPacer pacer_;  ///< measurement trigger: the steps no faster than the control rate
   double tick_delay_ = 0.0;
   GenericDimensions::OutputVector y_;
 };

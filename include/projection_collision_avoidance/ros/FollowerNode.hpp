@@ -50,7 +50,8 @@ struct FollowerConfiguration;
 /// carries the stamp of the measurement it answers). The timer still runs at control_rate, but
 /// steps only once the measurement is stale (the braking fallback); otherwise it only updates
 /// the diagnostics. The estimator integrates one period per step either way, so measurements are
-/// expected at control_rate.
+/// expected at control_rate; the steps are paced on their stamps (StepPacer), at most one per
+/// period, a measurement sooner being held (held_measurements).
 ///
 /// Period accounting (status and diagnostics): ticks (steps run), missed_periods ("timer":
 /// periods the timer skipped, its expected times more than 1.5 periods apart counting

@@ -62,6 +62,7 @@ void FollowerOutputs::remember(const FollowerCycleOutput& out) {
   latest_.time_headway = out.time_headway;
   latest_.missed_periods = out.missed_periods;
   latest_.late_periods = out.late_periods;
+  latest_.held_measurements = out.held_measurements;
   latest_.tick_delay = out.tick_delay;
   latest_.time_jumps = out.time_jumps;
   latest_.time_jump = out.time_jump;
@@ -267,6 +268,7 @@ void FollowerOutputs::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat
   status.add("ticks", s.steps);
   status.add("missed_periods", s.missed_periods);
   status.add("late_periods", s.late_periods);
+  status.add("held_measurements", s.held_measurements);
   status.add("tick_delay (s)", s.tick_delay);
 }
 

@@ -51,6 +51,7 @@ FollowerStatus toStatusMsg(const FollowerCycleOutput& out, const FollowerInputSt
   msg.ticks = out.steps;
   msg.missed_periods = out.missed_periods;
   msg.late_periods = out.late_periods;
+  msg.held_measurements = out.held_measurements;
   msg.tick_delay = out.tick_delay;
   msg.time_jumps = out.time_jumps;
   return msg;
