@@ -27,7 +27,7 @@ FollowerOutputs::FollowerOutputs(ros::NodeHandle nh, ros::NodeHandle private_nh,
       member_(member),
       separation_(separation),
       inputs_(inputs),
-      diagnostics_(nh, private_nh) {
+      diagnostics_(nh, private_nh, private_nh.getNamespace()) {
   command_publisher_.advertise<geometry_msgs::AccelStamped>(nh, "command", 10);
   broadcast_publisher_.advertise<LeaderBroadcast>(nh, "broadcast", 10);
   status_publisher_.advertise<FollowerStatus>(nh, "status", 10);
