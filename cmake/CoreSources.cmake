@@ -13,6 +13,7 @@ set(PCA_CORE_SOURCES
   src/core/Formation.cpp
   src/core/LinearAlgebra.cpp
   src/core/PlatoonLaws.cpp
+  src/core/TurningSlot.cpp
 )
 
 # projection_collision_avoidance_sim: simulation and experiment tooling around the controller

@@ -128,6 +128,23 @@ FormationSpec readFormation(YamlReader& reader) {
   if (formation.has("half_angle")) {
     spec.half_angle = formation.number("half_angle");
   }
+  if (formation.has("slots")) {
+    spec.slots = parseSlotFrame(formation.string("slots"), formation.key("slots"));
+  }
+  if (formation.has("turning")) {
+    YamlReader turning = formation.map("turning");
+    SlotHeadingParameters& heading = spec.turning;
+    for (const auto& [key, value] :
+         {std::pair{"natural_frequency", &heading.natural_frequency},
+          std::pair{"damping", &heading.damping}, std::pair{"max_yaw_rate", &heading.max_yaw_rate},
+          std::pair{"max_yaw_acceleration", &heading.max_yaw_acceleration},
+          std::pair{"min_speed", &heading.min_speed}}) {
+      if (turning.has(key)) {
+        *value = turning.number(key);
+      }
+    }
+    turning.finish();
+  }
   formation.finish();
   return spec;
 }

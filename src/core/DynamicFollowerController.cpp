@@ -61,6 +61,7 @@ const DynamicFollowerStatus& DynamicFollowerController::step(const DynamicStepIn
   checkSize(inputs.measurement, outputDimension(), "measurement");
   checkSize(inputs.leader_input, inputDimension(), "leader_input");
   checkSize(inputs.own_state, stateDimension(), "own_state");
+  checkSize(inputs.slot_acceleration, inputDimension(), "slot_acceleration");
   return visitStep([&](auto& controller) -> const auto& {
     using C = std::decay_t<decltype(controller)>;
     StepInputs<typename C::Dimensions> converted;
@@ -73,6 +74,9 @@ const DynamicFollowerStatus& DynamicFollowerController::step(const DynamicStepIn
     }
     if (inputs.own_state) {
       converted.own_state = as<typename C::StateVector>(*inputs.own_state);
+    }
+    if (inputs.slot_acceleration) {
+      converted.slot_acceleration = as<typename C::InputVector>(*inputs.slot_acceleration);
     }
     return controller.step(converted);
   });

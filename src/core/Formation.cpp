@@ -40,6 +40,15 @@ void FormationSpec::validate(const AgentModel& model) const {
                            "must lie in (0, pi/2) rad, got " + std::to_string(half_angle));
     }
   }
+  if (slots == SlotFrame::kTurning) {
+    const int axes = model.double_integrator_axes;
+    if (axes != 2 && axes != 3) {
+      throw ParameterError("formation.slots",
+                           "turning needs a double_integrator model of 2 or 3 axes (slots turn "
+                           "about z); use world");
+    }
+    turning.validate("formation.turning");
+  }
 }
 
 FormationMember formationSlot(const FormationSpec& spec, const Eigen::VectorXd& separation,
@@ -76,7 +85,16 @@ std::vector<FormationMember> layoutFormation(const FormationSpec& spec,
     const Eigen::VectorXd& target_state =
         member.target == 0 ? leader_initial_state
                            : members[static_cast<std::size_t>(member.target - 1)].initial_state;
-    member.initial_state = target_state - member.separation - initial_error;
+    Eigen::VectorXd slot = member.separation;
+    if (spec.slots == SlotFrame::kTurning) {
+      const int axes = static_cast<int>(target_state.size() / 2);
+      member.initial_heading =
+          velocityHeading(target_state(axes), target_state(axes + 1), spec.turning.min_speed)
+              .value_or(0.0);
+      turningSlotOffset(member.separation, axes, SlotHeadingSample{member.initial_heading, 0, 0},
+                        &slot);
+    }
+    member.initial_state = target_state - slot - initial_error;
     members.push_back(member);
   }
   return members;
@@ -103,6 +121,8 @@ std::string toString(FormationTopology topology) {
 
 std::string toString(FormationShape shape) { return shape == FormationShape::kV ? "v" : "line"; }
 
+std::string toString(SlotFrame frame) { return frame == SlotFrame::kTurning ? "turning" : "world"; }
+
 FormationTopology parseFormationTopology(const std::string& text, const std::string& key) {
   if (text == "star") {
     return FormationTopology::kStar;
@@ -121,6 +141,16 @@ FormationShape parseFormationShape(const std::string& text, const std::string& k
     return FormationShape::kV;
   }
   throw ParameterError(key, "must be line or v, got '" + text + "'");
+}
+
+SlotFrame parseSlotFrame(const std::string& text, const std::string& key) {
+  if (text == "world") {
+    return SlotFrame::kWorld;
+  }
+  if (text == "turning") {
+    return SlotFrame::kTurning;
+  }
+  throw ParameterError(key, "must be world or turning, got '" + text + "'");
 }
 
 }  // namespace projection_collision_avoidance

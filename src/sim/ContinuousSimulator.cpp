@@ -284,6 +284,11 @@ SimulationSummary simulateContinuous(const Scenario& scenario, double step,
     throw ParameterError("formation.followers",
                          "the continuous-time loop runs the pair (one follower)");
   }
+  if (scenario.formation.slots != SlotFrame::kWorld) {
+    throw ParameterError("formation.slots",
+                         "the continuous-time loop has world slots only (the sampled loop turns "
+                         "them)");
+  }
   if (scenario.link.active()) {
     const LinkSpec& link = scenario.link;
     throw ParameterError(std::string("controller.leader_information.link.") +

@@ -96,6 +96,9 @@ Scenario sweepScenario(const Scenario& base, const SweepConfiguration& configura
   if (base.formation.followers != 1) {
     throw ParameterError("formation.followers", "the sweep runs one follower");
   }
+  if (base.formation.slots != SlotFrame::kWorld) {
+    throw ParameterError("formation.slots", "the sweep runs the paper's world slot");
+  }
   const int axes = model.double_integrator_axes;
   Scenario scenario = base;
   const Eigen::VectorXd r =

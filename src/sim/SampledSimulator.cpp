@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <limits>
 #include <locale>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -14,6 +15,7 @@
 #include "projection_collision_avoidance/core/FollowerController.hpp"
 #include "projection_collision_avoidance/core/PaperLaws.hpp"
 #include "projection_collision_avoidance/core/ParameterError.hpp"
+#include "projection_collision_avoidance/core/TurningSlot.hpp"
 #include "projection_collision_avoidance/sim/AgentIntegrator.hpp"
 #include "projection_collision_avoidance/sim/SharedLink.hpp"
 
@@ -40,14 +42,19 @@ double positionDistance(const Vector& a, const Vector& b, int k) {
 /// One follower of the run: its controller, its plant and its figures.
 template <typename Dims>
 struct SimulatedFollower {
+  /// @param turning the slot heading's generator of turning slots; null for world slots
   SimulatedFollower(const FormationMember& formation_member, const ControllerDesign& member_design,
-                    const AgentModel& model)
+                    const AgentModel& model, const SlotHeadingParameters* turning)
       : member(formation_member),
         design(member_design),
         controller(member_design),
         plant(model, member_design.period, formation_member.initial_state),
         separation(formation_member.separation),
         command(Dims::InputVector::Zero(model.inputDimension())) {
+    if (turning) {
+      heading.emplace(*turning, member_design.period);
+      heading->reset(formation_member.initial_heading);
+    }
     summary.xi_max = design.xi_max;
     summary.perimeter = design.perimeter;
     summary.min_separation = std::numeric_limits<double>::infinity();
@@ -59,6 +66,7 @@ struct SimulatedFollower {
   AgentIntegrator<Dims> plant;
   typename Dims::StateVector separation;  // d_i
   typename Dims::InputVector command;     // u_i at the current tick
+  std::optional<SlotHeading> heading;     // theta_i (T1) of a turning slot
   SimulationSummary summary;
 };
 
@@ -76,6 +84,7 @@ FormationSummary runFormation(const Scenario& scenario, const ControllerDesign& 
   const bool share_leader_input = p.leader_input_in_command || p.leader_input_in_estimator;
   const typename Dims::OutputMatrix output_matrix = model.C;
 
+  const bool turning = scenario.formation.slots == SlotFrame::kTurning;
   const std::vector<FormationMember> members =
       layoutFormation(scenario.formation, p.separation, scenario.leader_initial_state,
                       scenario.follower_initial_state);
@@ -83,7 +92,8 @@ FormationSummary runFormation(const Scenario& scenario, const ControllerDesign& 
   std::vector<SimulatedFollower<Dims>> followers;
   followers.reserve(members.size());
   for (const FormationMember& member : members) {
-    followers.emplace_back(member, ControllerDesign::create(memberParameters(p, member)), model);
+    followers.emplace_back(member, ControllerDesign::create(memberParameters(p, member)), model,
+                           turning ? &scenario.formation.turning : nullptr);
   }
   AgentIntegrator<Dims> leader(model, scenario_design.period, scenario.leader_initial_state,
                                scenario.disturbance);
@@ -121,12 +131,26 @@ FormationSummary runFormation(const Scenario& scenario, const ControllerDesign& 
       const InputVector& target_acceleration =
           use_link ? link.receive(follower.member.index, follower.member.target, tick)
                    : (behind_leader ? leader_acceleration : ahead->command);
-      const StateVector xi = target_state - follower.plant.state() - follower.separation;
+      StateVector slot = follower.separation;  // D_i (T2)
+      SlotHeadingSample heading;
+      InputVector slot_acceleration;  // u_r (T3)
+      if (follower.heading) {
+        // The heading of the target's velocity: for C = I the follower's own velocity plus the
+        // measured relative one.
+        heading = follower.heading->tick(velocityHeading(target_state(k), target_state(k + 1),
+                                                         scenario.formation.turning.min_speed));
+        turningSlotOffset(follower.separation, k, heading, &slot);
+        turningSlotAcceleration(follower.separation, k, heading, &slot_acceleration);
+      }
+      const StateVector xi = target_state - follower.plant.state() - slot;
       const OutputVector y = output_matrix * xi;
       const StateVector& own_state = follower.plant.state();
       StepInputs<Dims> inputs{y, std::nullopt, own_state};
       if (share_leader_input) {
         inputs.leader_input = target_acceleration;
+      }
+      if (follower.heading) {
+        inputs.slot_acceleration = slot_acceleration;
       }
       const auto& status = follower.controller.step(inputs);
       follower.command = status.command;
@@ -154,6 +178,8 @@ FormationSummary runFormation(const Scenario& scenario, const ControllerDesign& 
         sample.leader_state = target_state;
         sample.follower_state = follower.plant.state();
         sample.distance = separation;
+        sample.slot_heading = heading;
+        sample.slot = slot;
         sample.controller = status;
         sample.leader_input = behind_leader ? leader_input : ahead->command;
         sample.disturbance = behind_leader ? disturbance : zero_disturbance;

@@ -28,6 +28,7 @@ SimulationCsvWriter::SimulationCsvWriter(std::ostream& out, const Scenario& scen
       inputs_(scenario.controller.model.inputDimension()),
       positions_(scenario.controller.model.position_dimension),
       velocities_(scenario.controller.model.isDoubleIntegrator()),
+      turning_(scenario.formation.slots == SlotFrame::kTurning),
       xi_max_(hardBound(scenario.controller.alpha, scenario.controller.separation.norm())),
       xi_soft_(softBound(xi_max_, scenario.controller.epsilon)),  // xi_max_ is set above
       perimeter_(
@@ -49,6 +50,11 @@ SimulationCsvWriter::SimulationCsvWriter(std::ostream& out, const Scenario& scen
   writeHeaderColumns(out_, "u_tracker_", inputs_);
   writeHeaderColumns(out_, "leader_u_", inputs_);
   writeHeaderColumns(out_, "ud_", states_);
+  if (turning_) {
+    out_ << ",slot_heading,slot_yaw_rate,slot_yaw_acceleration";
+    writeHeaderColumns(out_, "slot_p_", positions_);
+    writeHeaderColumns(out_, "u_slot_", inputs_);
+  }
   out_ << '\n';
 }
 
@@ -71,6 +77,12 @@ void SimulationCsvWriter::write(const SimulationSample& s) {
   writeValues(out_, s.controller.tracker_command, inputs_);
   writeValues(out_, s.leader_input, inputs_);
   writeValues(out_, s.disturbance, states_);
+  if (turning_) {
+    out_ << ',' << s.slot_heading.angle << ',' << s.slot_heading.rate << ','
+         << s.slot_heading.acceleration;
+    writeValues(out_, s.slot, positions_);
+    writeValues(out_, s.controller.slot_command, inputs_);
+  }
   out_ << '\n';
 }
 

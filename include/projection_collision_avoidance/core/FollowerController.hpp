@@ -63,6 +63,8 @@ class FollowerController {
     status_.feedforward_command = status_.command;
     status_.headway_command = status_.command;
     status_.fallback_command = status_.command;
+    status_.slot_command = status_.command;
+    known_feedforward_ = status_.command;
     status_.estimate = estimator_.estimate();
   }
 
@@ -80,6 +82,12 @@ class FollowerController {
   ///   velocity decays as e^{-k_v t}. Before any measurement the estimate is zero. If u_ff + K_f
   ///   xi_hat overflows (huge gains), the command is u_ff alone (command_overflow).
   ///
+  /// A turning slot's acceleration u_r (T3), when given, is a known input: added to the command
+  /// in either mode and left out of the augmentation the estimator integrates (in the fallback,
+  /// u_2 = rate(sat(u_ff + u_r + K_f xi_hat)) and xi_hat' = Proj(A xi_hat + B (u_1m - u_2 + u_r))),
+  /// so that the estimator's model of xi' stays the paper's; a non-finite one is taken as 0
+  /// (status.slot_acceleration_rejected).
+  ///
   /// The leader's input u_1 (its acceleration a_1) is used as configured by
   /// leader_input_in_command / leader_input_in_estimator; one with a non-finite entry is taken as
   /// unknown for this tick (status.leader_input_rejected). The own state x_2 lets the time
@@ -90,6 +98,7 @@ class FollowerController {
   const FollowerControllerStatus<Dims>& step(const StepInputs<Dims>& inputs) {
     const bool leader_input_known = inputs.leader_input.has_value();
     period_fraction_ = inputs.period_fraction;
+    setSlotAcceleration(inputs.slot_acceleration ? &*inputs.slot_acceleration : nullptr);
     return tick(inputs.measurement ? &*inputs.measurement : nullptr,
                 leader_input_known ? *inputs.leader_input : InputVector::Zero(input_matrix_.cols()),
                 leader_input_known, inputs.own_state ? &*inputs.own_state : nullptr);
@@ -152,6 +161,10 @@ class FollowerController {
       y = nullptr;
     }
     setFeedforward(leader_input, leader_input_known);
+    known_feedforward_ = status_.feedforward_command;
+    if (slot_acting_) {
+      known_feedforward_ += status_.slot_command;
+    }
     if (y != nullptr && advance(*y, leader_input, leader_input_known, own_state)) {
       return status_;
     }
@@ -182,7 +195,7 @@ class FollowerController {
       initialize(y);
     }
     const StateVector& estimate = estimator_.estimate();
-    law_.compose(y, output_matrix_ * estimate, status_.feedforward_command, own_state, &terms_);
+    law_.compose(y, output_matrix_ * estimate, known_feedforward_, own_state, &terms_);
     status_.baseline_command = terms_.baseline;
     status_.tracker_command = terms_.tracker;
     status_.headway_command = terms_.headway;
@@ -198,8 +211,8 @@ class FollowerController {
     status_.fallback_command.setZero();
     status_.fallback = false;
     status_.command_rate_limited = rate_limiter_.limit(status_.command, period_fraction_);
-    const InputVector acting = law_.acting(terms_, status_.command, status_.feedforward_command,
-                                           status_.command_rate_limited);
+    const InputVector acting =
+        law_.acting(terms_, status_.command, known_feedforward_, status_.command_rate_limited);
     const EstimatorPeriodReport report =
         estimator_.advance(y, acting, knownDrift(leader_input, leader_input_known), design_.period,
                            design_.parameters.estimator_substeps);
@@ -221,17 +234,18 @@ class FollowerController {
     status_.headway_command.setZero();
     status_.fallback = true;
     status_.fallback_command = fallback_gain_ * estimate;
-    status_.command = status_.feedforward_command + status_.fallback_command;
-    if (!status_.command.allFinite()) {  // K_f xi_hat overflows: u_ff alone (finite)
+    status_.command = known_feedforward_ + status_.fallback_command;
+    if (!status_.command.allFinite()) {  // K_f xi_hat overflows: u_ff [+ u_r] alone (finite)
       status_.command_overflow = true;
       status_.fallback_command.setZero();
-      status_.command = status_.feedforward_command;
+      status_.command = known_feedforward_;
     }
     limitCommand();
 
-    // xi' = A xi + B (u_1 - u_ff) - B (u_2 - u_ff), with u_1 - u_ff modelled as in step().
+    // xi' = A xi + B (u_1 - u_ff) - B (u_2 - u_ff - u_r), with u_1 - u_ff modelled as in step()
+    // and u_r the turning slot's acceleration (T3).
     const StateVector drift = knownDrift(leader_input, leader_input_known) -
-                              input_matrix_ * (status_.command - status_.feedforward_command);
+                              input_matrix_ * (status_.command - known_feedforward_);
     const EstimatorPeriodReport report =
         estimator_.predict(drift, design_.period, p.estimator_substeps);
     status_.projection_active = report.projection_active;
@@ -258,6 +272,21 @@ class FollowerController {
     }
   }
 
+  /// u_r of this tick (T3): the given turning slot's acceleration, 0 when absent or not finite
+  /// (slot_acceleration_rejected).
+  void setSlotAcceleration(const InputVector* slot_acceleration) {
+    status_.slot_acceleration_rejected = false;
+    status_.slot_command.setZero();
+    slot_acting_ = false;
+    if (slot_acceleration != nullptr) {
+      if (slot_acceleration->allFinite()) {
+        status_.slot_command = *slot_acceleration;
+        slot_acting_ = true;
+      } else {
+        status_.slot_acceleration_rejected = true;
+      }
+    }
+  }
   /// The fallback's limits: sat() of (10) (saturateCommand(): euclideanNorm(command) <=
   /// acceleration_limit exactly, no overflow), then the change from the previous tick's command
   /// limited to jerk_limit T, inside the same ball.
@@ -278,7 +307,9 @@ class FollowerController {
   FeedforwardFilter<InputVector> feedforward_filter_;       // (S2)
   CommandRateLimiter<InputVector> rate_limiter_;            // jerk_limit, from u_2(k-1)
   FollowerControllerStatus<Dims> status_;
-  double period_fraction_ = 1.0;  // of this step (StepInputs::period_fraction)
+  InputVector known_feedforward_;  // u_ff + u_r: the command's known inputs of this tick
+  bool slot_acting_ = false;       // u_r given at this step
+  double period_fraction_ = 1.0;   // of this step (StepInputs::period_fraction)
   bool initialized_ = false;
 };
 

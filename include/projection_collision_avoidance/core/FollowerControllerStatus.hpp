@@ -14,10 +14,11 @@ struct FollowerControllerStatus {
   typename Dims::InputVector feedforward_command;  ///< u_ff (S2) if shared in the command, else 0
   typename Dims::InputVector headway_command;      ///< K_h x_2 (S1); 0 without the time headway
   typename Dims::InputVector fallback_command;     ///< K_f xi_hat in the fallback, else 0
-  typename Dims::StateVector estimate;             ///< xi_hat used at this tick (m)
-  double estimate_norm = 0.0;                      ///< ||xi_hat|| (m), euclideanNorm()
-  double constraint_value = 0.0;                   ///< f(xi_hat) (13)
-  bool command_saturated = false;  ///< the sum exceeded acceleration_limit and was scaled
+  typename Dims::InputVector slot_command;  ///< u_r (T3) of a turning slot; 0 for a world slot
+  typename Dims::StateVector estimate;      ///< xi_hat used at this tick (m)
+  double estimate_norm = 0.0;               ///< ||xi_hat|| (m), euclideanNorm()
+  double constraint_value = 0.0;            ///< f(xi_hat) (13)
+  bool command_saturated = false;           ///< the sum exceeded acceleration_limit and was scaled
   /// The saturated command was more than jerk_limit T from the previous one and was moved to
   /// that distance from it.
   bool command_rate_limited = false;
@@ -29,6 +30,8 @@ struct FollowerControllerStatus {
   bool measurement_rejected = false;
   /// The leader's input u_1 had a non-finite entry: this tick took it as unknown.
   bool leader_input_rejected = false;
+  /// The turning slot's acceleration u_r had a non-finite entry: this tick took it as 0.
+  bool slot_acceleration_rejected = false;
   /// The laws' command was not finite (an overflow with huge finite measurements, inputs or
   /// gains) and was replaced: in step() by the fallback's for this tick (fallback is set), in the
   /// fallback by the feed-forward u_ff alone (zero when u_1 is not shared), saturated.
@@ -51,6 +54,7 @@ struct FollowerControllerStatus {
     feedforward_command = other.feedforward_command;
     headway_command = other.headway_command;
     fallback_command = other.fallback_command;
+    slot_command = other.slot_command;
     estimate = other.estimate;
     estimate_norm = other.estimate_norm;
     constraint_value = other.constraint_value;
@@ -61,6 +65,7 @@ struct FollowerControllerStatus {
     boundary_correction = other.boundary_correction;
     measurement_rejected = other.measurement_rejected;
     leader_input_rejected = other.leader_input_rejected;
+    slot_acceleration_rejected = other.slot_acceleration_rejected;
     command_overflow = other.command_overflow;
     estimate_held = other.estimate_held;
     return *this;

@@ -7,6 +7,7 @@
 
 #include "projection_collision_avoidance/core/AgentModel.hpp"
 #include "projection_collision_avoidance/core/ControllerParameters.hpp"
+#include "projection_collision_avoidance/core/TurningSlot.hpp"
 
 namespace projection_collision_avoidance {
 
@@ -22,6 +23,12 @@ enum class FormationShape {
   kV,     ///< two arms, d turned by +half_angle (odd followers) and -half_angle (even ones)
 };
 
+/// The frame the slots d_i are given in (formation.slots).
+enum class SlotFrame {
+  kWorld,    ///< fixed in the world, as the paper's d: the formation translates, never turns
+  kTurning,  ///< in the target's body frame, turned with the slot heading theta (T1)-(T3)
+};
+
 /// The followers of a scenario (section `formation` of a scenario file). Without that section a
 /// scenario has one follower, named "follower", on the scenario's d: the paper's pair.
 struct FormationSpec {
@@ -30,12 +37,15 @@ struct FormationSpec {
   FormationTopology topology = FormationTopology::kStar;
   FormationShape shape = FormationShape::kLine;
   double half_angle = 0.5235987755982988;  ///< rad, angle of each arm of a V to d (30 deg)
+  SlotFrame slots = SlotFrame::kWorld;     ///< formation.slots
+  SlotHeadingParameters turning;           ///< formation.turning (slots: turning)
 
   static constexpr int kMaxFollowers = 1000;
 
   /// Throws ParameterError naming formation.followers / .shape / .half_angle for a count out of
   /// range, a V on a model that is not a double integrator of 2 or 3 axes, or an angle outside
-  /// (0, pi/2).
+  /// (0, pi/2); formation.slots for turning slots on such a model; formation.turning.* for a
+  /// bad generator (SlotHeadingParameters::validate()).
   void validate(const AgentModel& model) const;
 };
 
@@ -44,10 +54,16 @@ struct FormationMember {
   std::string name;  ///< "follower" (no formation section) or "follower_<i>"; also its tf frame
   int index = 1;     ///< i, 1 .. N
   int target = 0;    ///< the agent it looks at: 0 the leader, j in 1 .. i-1 follower j
-  std::string target_name;     ///< "leader" or the name of follower j
-  Eigen::VectorXd separation;  ///< d_i: x_target - x_i on the slot (in ker A)
-  /// x_i(0) = x_target(0) - d_i - xi_0, with xi_0 = x_1(0) - x_2(0) - d the scenario's initial
-  /// relative error, so that every follower starts as the scenario's single follower does.
+  std::string target_name;  ///< "leader" or the name of follower j
+  /// d_i: x_target - x_i on the slot (in ker A); with turning slots, in the target's body frame
+  /// (the world's at theta = 0)
+  Eigen::VectorXd separation;
+  /// theta(0) of a turning slot (rad): the heading of the target's initial velocity
+  /// (velocityHeading()), 0 when it has none; 0 for world slots.
+  double initial_heading = 0.0;
+  /// x_i(0) = x_target(0) - D_i - xi_0 (D_i = d_i, or turned by theta(0) (T2)), with xi_0 = x_1(0)
+  /// - x_2(0) - d the scenario's initial relative error, so that every follower starts as the
+  /// scenario's single follower does.
   Eigen::VectorXd initial_state;
 };
 
@@ -58,6 +74,7 @@ FormationMember formationSlot(const FormationSpec& spec, const Eigen::VectorXd& 
 
 /// The followers of a formation in index order (every target precedes its follower).
 ///
+/// With turning slots, follower i starts on its slot turned by theta_i(0) (initial_heading).
 /// With d the scenario's separation, r_i = ceil(i / 2) and R(+-theta) the rotation of the
 /// position part about the z axis (the x-y plane) by the V's half angle theta, sign + for odd i:
 ///   star, line:   d_i = i d,                target 0
@@ -77,12 +94,15 @@ std::vector<FormationMember> layoutFormation(const FormationSpec& spec,
 ControllerParameters memberParameters(const ControllerParameters& parameters,
                                       const FormationMember& member);
 
-/// "star", "chain"; "line", "v".
+/// "star", "chain"; "line", "v"; "world", "turning".
 std::string toString(FormationTopology topology);
 std::string toString(FormationShape shape);
+std::string toString(SlotFrame frame);
 
 /// Parses "star" / "chain" and "line" / "v"; throws ParameterError(key) otherwise.
 FormationTopology parseFormationTopology(const std::string& text, const std::string& key);
 FormationShape parseFormationShape(const std::string& text, const std::string& key);
+/// Parses "world" / "turning"; throws ParameterError(key) otherwise.
+SlotFrame parseSlotFrame(const std::string& text, const std::string& key);
 
 }  // namespace projection_collision_avoidance

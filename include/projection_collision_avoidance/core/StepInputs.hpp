@@ -19,6 +19,9 @@ struct StepInputs {
   std::optional<typename Dims::InputVector> leader_input{};
   /// The follower's own state x_2 (m, m/s), for the time headway (S1); absent: it does not act.
   std::optional<typename Dims::StateVector> own_state{};
+  /// The turning slot's own acceleration u_r (m/s^2), (T3): a known input that the command adds
+  /// and the estimator's acting augmentation leaves out; absent: a slot fixed in the world.
+  std::optional<typename Dims::InputVector> slot_acceleration{};
   /// Delta t / T: the part of a control period T since the previous step's command, which the
   /// rate limit scales its allowed change by (jerk_limit Delta t; CommandRateLimiter::limit());
   /// 1 (the default): a whole period.
@@ -28,9 +31,10 @@ struct StepInputs {
 /// StepInputs of any sizes, the argument of DynamicFollowerController::step(): each entry a
 /// vector of the model's size (outputDimension(), inputDimension(), stateDimension()).
 struct DynamicStepInputs {
-  std::optional<Eigen::Ref<const Eigen::VectorXd>> measurement{};   ///< y (m, m/s)
-  std::optional<Eigen::Ref<const Eigen::VectorXd>> leader_input{};  ///< a_1 (m/s^2)
-  std::optional<Eigen::Ref<const Eigen::VectorXd>> own_state{};     ///< x_2 (m, m/s)
+  std::optional<Eigen::Ref<const Eigen::VectorXd>> measurement{};        ///< y (m, m/s)
+  std::optional<Eigen::Ref<const Eigen::VectorXd>> leader_input{};       ///< a_1 (m/s^2)
+  std::optional<Eigen::Ref<const Eigen::VectorXd>> own_state{};          ///< x_2 (m, m/s)
+  std::optional<Eigen::Ref<const Eigen::VectorXd>> slot_acceleration{};  ///< u_r (m/s^2)
   double period_fraction = 1.0;  ///< Delta t / T since the previous step (StepInputs)
 };
 

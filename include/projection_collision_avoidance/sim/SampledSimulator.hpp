@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 
 #include "projection_collision_avoidance/core/FollowerControllerStatus.hpp"
+#include "projection_collision_avoidance/core/TurningSlot.hpp"
 #include "projection_collision_avoidance/sim/Scenario.hpp"
 
 namespace projection_collision_avoidance {
@@ -19,8 +20,12 @@ struct SimulationSample {
   Eigen::VectorXd leader_state;    ///< x_1
   Eigen::VectorXd follower_state;  ///< x_2
   double distance = 0.0;           ///< ||p_1 - p_2|| (m)
-  Eigen::VectorXd leader_input;    ///< the target's acceleration input (u_1(t_k) for the leader)
-  Eigen::VectorXd disturbance;     ///< the target's disturbance (u_d(t_k) for the leader, else 0)
+  /// The slot heading theta, theta' and theta'' of a turning slot (T1) (rad, rad/s, rad/s^2);
+  /// 0 for a world slot.
+  SlotHeadingSample slot_heading;
+  Eigen::VectorXd slot;          ///< D = x_1 - x_2 on the slot (T2): d, or d turned by theta
+  Eigen::VectorXd leader_input;  ///< the target's acceleration input (u_1(t_k) for the leader)
+  Eigen::VectorXd disturbance;   ///< the target's disturbance (u_d(t_k) for the leader, else 0)
   /// The controller's status at t_k, the one type the nodes publish (estimate, f, projection,
   /// command and its parts); the continuous loop fills the fields it has.
   DynamicFollowerStatus controller;
@@ -55,13 +60,15 @@ using FormationObserver = std::function<void(int member, const SimulationSample&
 /// Runs the closed loop of a scenario's formation without ROS: at each tick t_k = k /
 /// control_rate, for k = 0 .. round(duration * control_rate), every follower i in index order
 /// steps on y_i = C (x_target - x_i - d_i); then every agent is integrated exactly to t_{k+1},
-/// inputs held, the leader's step split at disturbance pulse edges. Each follower is given its own
-/// state x_i for the time headway (S1). With leader information (controller.leader_information)
-/// a follower of the leader is given a_1 = u_1(t_k) (+ pinv(B) u_d(t_k) when the disturbance is
-/// shared), and a follower of follower j the command follower j computed at the same tick; with
-/// a link section, these values as the link delivers them instead ((L1)-(L3): delayed by D
-/// periods, lost with probability dropout, the last one held). Throws ParameterError for an
-/// invalid scenario.
+/// inputs held, the leader's step split at disturbance pulse edges. With turning slots
+/// (formation.slots: turning) follower i's slot is D_i (T2), turned by its slot heading (T1),
+/// which follows the heading of its target's velocity, and it is given u_r (T3). Each follower is
+/// given its own state x_i for the time headway (S1). With leader information
+/// (controller.leader_information) a follower of the leader is given a_1 = u_1(t_k) (+ pinv(B)
+/// u_d(t_k) when the disturbance is shared), and a follower of follower j the command follower j
+/// computed at the same tick; with a link section, these values as the link delivers them instead
+/// ((L1)-(L3): delayed by D periods, lost with probability dropout, the last one held). Throws
+/// ParameterError for an invalid scenario.
 FormationSummary simulateFormation(const Scenario& scenario,
                                    const FormationObserver& observer = {});
 

@@ -10,7 +10,9 @@ namespace projection_collision_avoidance {
 /// Writes a run as CSV: a header row on construction, then one row per control tick with the
 /// columns of README.md, "Scenario files" (t, xi_*, xi_hat_*, norms, bounds, f, projection_active,
 /// positions, velocities for double integrators, separation, perimeter, u_*, u_baseline_*,
-/// u_tracker_*, leader_u_*, ud_*).
+/// u_tracker_*, leader_u_*, ud_*); with turning slots (formation.slots: turning) then
+/// slot_heading, slot_yaw_rate, slot_yaw_acceleration (theta, theta', theta'' of (T1)),
+/// slot_p_* (the turned slot's position part R(theta) d_p, (T2)) and u_slot_* (u_r, (T3)).
 class SimulationCsvWriter {
  public:
   SimulationCsvWriter(std::ostream& out, const Scenario& scenario);
@@ -22,6 +24,7 @@ class SimulationCsvWriter {
   int inputs_;
   int positions_;
   bool velocities_;
+  bool turning_;
   double xi_max_;
   double xi_soft_;
   double perimeter_;
