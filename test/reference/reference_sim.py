@@ -35,15 +35,54 @@ the follower through xi only. The flag matters only when ``command`` or
 ``estimator`` is on. With both on, B (a_1 - u_ff) = 0: the estimator then
 needs no model of the fed-forward acceleration, which cancels in xi'.
 
-Only the paper's pair is covered: a scenario with a ``formation`` section is
-refused (exit 2) unless it has followers: 1 and the line shape, which is the pair.
+Turning slots (doc/math.md, section 'Turning slots', (T1)-(T3); ``formation.slots:
+turning``, a double integrator of 2 or 3 axes). The slot d = [d_p; 0] is given in the
+leader's body frame and turned about z by the slot heading theta, two more states
+integrated with the rest::
+
+    psi     = atan2(v_y, v_x)  of the leader's velocity v (its heading)
+    psi'    = (v_x a_y - v_y a_x) / (v_x^2 + v_y^2),  a = u_1 + pinv(B) u_d (its true
+              acceleration); psi := theta, psi' := 0 where ||v|| < min_speed
+    theta'' = clamp(w^2 wrap(psi - theta) + 2 zeta w (psi' - theta'), +-beta),
+              and theta'' <= 0 at theta' >= max_yaw_rate (>= 0 at <= -max_yaw_rate)   (T1)
+    D       = [R(theta) d_p; theta' J R(theta) d_p]                                 (T2)
+    xi      = x_1 - x_2 - D
+    u_r     = -(theta'' J + theta'^2 J^2) R(theta) d_p                              (T3)
+    u_2     = G y + u_a + u_ff + u_r
+
+with wrap() to (-pi, pi], R(theta) the turn of the x-y part by theta (z kept) and
+J = [[0, -1], [1, 0]] on x-y (0 on z). u_r is a known input that cancels between the
+plant and the estimator's model (the augmentation that acts, u_2 - G y - u_ff - u_r, is
+u_a), so h above is unchanged. theta(0) = psi(0) (0 if the leader starts below
+min_speed), theta'(0) = 0, and the follower starts at x_2(0) = x_1(0) - D(theta(0), 0)
+- xi_0 with xi_0 = x_1(0) - x_2(0) - d from the scenario: on its turned slot if the
+scenario puts it on its slot. In 3-D the threshold is on the whole speed ||v||, as
+doc/math.md writes it. Where cf_sim holds theta'' and u_r over a control period and
+takes psi' as a difference quotient, this is exact in time: the two agree to O(T).
+
+Formations: a ``formation`` section (keys as cf_sim's) is covered when every follower
+looks at the leader, i.e. ``followers: 1`` (either topology) or ``topology: star``; a
+chain of more followers is refused (exit 2). Follower i runs the pair's loop on its own
+d_i (doc/formations.md: line i d; V ceil(i/2) R(+-half_angle) d, + for odd i), with its
+own xi_max, and starts with the scenario's xi_0; the followers do not interact, so each
+is simulated alone. The output is then cf_sim's: a line
+``follower_<i> target=leader max_xi=..`` per follower, then
+``formation followers=.. topology=.. shape=.. slots=.. min_pair_separation=.. wall_s=..``
+(the smallest distance between any two agents, leader included, on the grid); --csv FILE
+writes FILE with _follower_<i> before its extension, per follower.
 
 The input and disturbance pulses make the right-hand side discontinuous in time,
 so the integration is restarted at every pulse edge. Inside a segment the
 right-hand side is Lipschitz (the projection term vanishes continuously at
-f = 0 and at grad_f^T h = 0). The solution is reported on the grid
+f = 0 and at grad_f^T h = 0), except with turning slots, where theta'' switches at
+|theta'| = max_yaw_rate, at ||v|| = min_speed and where psi - theta crosses +-pi; there
+the solver's error control shortens the steps (it converges: the summary of the figure
+eight moves by < 3e-7 m from rtol 1e-6 to 1e-9, with or without --max-step 0.01).
+The solution is reported on the grid
 t_k = k / control_rate, k = 0 .. N with N = floor(duration * control_rate), the
-rows of the CSV of cf_sim.
+rows of the CSV of cf_sim; with turning slots the CSV adds cf_sim's columns
+slot_heading, slot_yaw_rate, slot_yaw_acceleration, slot_p_* (R(theta) d_p) and
+u_slot_* (u_r).
 
 Usage::
 
@@ -56,7 +95,9 @@ Exit codes: 0 success, 1 integration failure, 2 bad command line or scenario.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import math
+import os
 import sys
 import time
 from dataclasses import dataclass, field
@@ -115,7 +156,20 @@ SCHEMA = {
     },
     "follower": {"initial_state": None},
     "simulation": {"duration": None},
-    "formation": {"followers": None, "topology": None, "shape": None, "half_angle": None},
+    "formation": {
+        "followers": None,
+        "topology": None,
+        "shape": None,
+        "half_angle": None,
+        "slots": None,
+        "turning": {
+            "natural_frequency": None,
+            "damping": None,
+            "max_yaw_rate": None,
+            "max_yaw_acceleration": None,
+            "min_speed": None,
+        },
+    },
 }
 
 
@@ -291,6 +345,7 @@ class Scenario:
     sinusoids: list = field(default_factory=list)      # (amplitude, freq, phase)
     disturbances: list = field(default_factory=list)   # (start, end, n-vector)
     duration: float = 0.0
+    formation: Formation = None     # None: the pair, no formation section
 
     def __post_init__(self):
         self.n, self.m = self.B.shape
@@ -303,6 +358,9 @@ class Scenario:
         self.Gamma = lyapunov_gamma(self.F, self.Q)
         self.Gamma_inv = np.linalg.inv(self.Gamma)
         self.B_pinv = np.linalg.pinv(self.B)
+        self.turning = (self.formation.turning
+                        if self.formation is not None and self.formation.slots == "turning"
+                        else None)
 
 
 def lyapunov_gamma(F, Q):
@@ -361,22 +419,109 @@ def _pulses(items, path, size):
     return out
 
 
-def check_single_pair(formation):
-    """Refuse a formation: the reference simulates the leader-follower pair only."""
-    if formation is None:
-        return
-    followers = get(formation, "followers", "formation")
+@dataclass(frozen=True)
+class Turning:
+    """The slot heading generator (T1) of doc/math.md, section 'Turning slots'."""
+
+    natural_frequency: float = 1.0      # omega_theta, rad/s
+    damping: float = 1.0                # zeta_theta
+    max_yaw_rate: float = 0.5           # omega_max, rad/s
+    max_yaw_acceleration: float = 0.5   # beta, rad/s^2
+    min_speed: float = 0.5              # m/s: below it the target has no heading
+
+
+@dataclass(frozen=True)
+class Formation:
+    """The scenario's formation section: followers that all look at the leader."""
+
+    followers: int = 1
+    topology: str = "star"
+    shape: str = "line"
+    half_angle: float = math.pi / 6.0   # rad, each arm of a V to d
+    slots: str = "world"                # world | turning
+    turning: Turning = field(default_factory=Turning)
+
+
+def parse_formation(node, double_integrator, k):
+    """The formation section, or None without one.
+
+    Covered: a star (every follower looks at the leader, so that each runs the
+    pair's loop on its own d_i and is simulated alone) and the single follower of
+    either topology. A chain of more than one follower is refused.
+    """
+    if node is None:
+        return None
+    followers = get(node, "followers", "formation")
     if isinstance(followers, bool) or not isinstance(followers, int):
         raise ScenarioError(f"formation.followers: expected an integer, got {followers!r}")
-    if followers != 1:
+    if not 1 <= followers <= 1000:
+        raise ScenarioError(f"formation.followers: expected 1 .. 1000, got {followers}")
+    topology = node.get("topology", "star")
+    if topology not in ("star", "chain"):
+        raise ScenarioError(f"formation.topology: expected star or chain, got {topology!r}")
+    if topology == "chain" and followers > 1:
         raise ScenarioError(
-            f"formation.followers = {followers}: formations are not covered by the "
-            "reference, which simulates one leader-follower pair (followers: 1)")
-    shape = formation.get("shape", "line")
-    if shape != "line":
+            f"formation.topology = chain with {followers} followers: not covered by the "
+            "reference, which simulates followers that look at the leader (a star, or "
+            "followers: 1)")
+    shape = node.get("shape", "line")
+    if shape not in ("line", "v"):
+        raise ScenarioError(f"formation.shape: expected line or v, got {shape!r}")
+    half_angle = as_float(node.get("half_angle", Formation.half_angle), "formation.half_angle")
+    if not 0.0 < half_angle < math.pi / 2.0:
+        raise ScenarioError("formation.half_angle: must be in (0, pi/2)")
+    slots = node.get("slots", "world")
+    if slots not in ("world", "turning"):
+        raise ScenarioError(f"formation.slots: expected world or turning, got {slots!r}")
+    planar = double_integrator and k in (2, 3)
+    if shape == "v" and not planar:
+        raise ScenarioError("formation.shape = v needs a double_integrator model of 2 or 3 axes")
+    if slots == "turning" and not planar:
         raise ScenarioError(
-            f"formation.shape = {shape!r}: only the line shape (the pair on d) is covered "
-            "by the reference")
+            "formation.slots = turning needs a double_integrator model of 2 or 3 axes "
+            "(the slot turns about z); use world")
+
+    tnode = node.get("turning") or {}
+    if not isinstance(tnode, dict):
+        raise ScenarioError("formation.turning: expected a mapping")
+    values = {}
+    for key, default in vars(Turning()).items():
+        value = as_float(tnode.get(key, default), f"formation.turning.{key}")
+        if key == "min_speed" and not value >= 0.0:
+            raise ScenarioError("formation.turning.min_speed: must be >= 0")
+        if key != "min_speed" and not value > 0.0:
+            raise ScenarioError(f"formation.turning.{key}: must be > 0")
+        values[key] = value
+    return Formation(followers=followers, topology=topology, shape=shape,
+                     half_angle=half_angle, slots=slots, turning=Turning(**values))
+
+
+def slot_layout(formation, d, k):
+    """d_i of followers 1 .. N (doc/formations.md): line i d; V ceil(i/2) R(+-half_angle) d.
+
+    R turns the x-y part of d's position part, + for odd i and - for even i.
+    """
+    if formation is None:
+        return [d]
+    out = []
+    for i in range(1, formation.followers + 1):
+        if formation.shape == "line":
+            out.append(i * d)
+            continue
+        angle = formation.half_angle if i % 2 else -formation.half_angle
+        di = d.copy()
+        di[:k] = rotate_z(d[:k], angle)
+        out.append(math.ceil(i / 2) * di)
+    return out
+
+
+def rotate_z(p, angle):
+    """R(angle) p: the x-y part (first two entries) turned by angle, the rest kept."""
+    c, s = math.cos(angle), math.sin(angle)
+    out = np.array(p, dtype=float)
+    out[0] = c * p[0] - s * p[1]
+    out[1] = s * p[0] + c * p[1]
+    return out
 
 
 def build_scenario(raw):
@@ -384,7 +529,6 @@ def build_scenario(raw):
     if not isinstance(raw, dict):
         raise ScenarioError("the scenario must be a YAML mapping")
     check_keys(raw, SCHEMA)
-    check_single_pair(raw.get("formation"))
 
     model = get(raw, "model", "")
     mtype = get(model, "type", "model")
@@ -510,13 +654,15 @@ def build_scenario(raw):
     if not duration > 0:
         raise ScenarioError("simulation.duration: must be > 0")
 
+    formation = parse_formation(raw.get("formation"), double_integrator, k)
+
     return Scenario(A=A, B=B, C=C, k=k, double_integrator=double_integrator,
                     control_rate=control_rate, d=d, alpha=alpha, epsilon=epsilon,
                     G=G, L=L, Q=Q, initial_estimate=init, tracker=tracker, Ge=Ge, S21=S21,
                     info_command=info_command, info_estimator=info_estimator,
                     info_disturbance=info_disturbance,
                     x1_0=x1_0, x2_0=x2_0, input_pulses=input_pulses, sinusoids=sinusoids,
-                    disturbances=disturbances, duration=duration)
+                    disturbances=disturbances, duration=duration, formation=formation)
 
 
 def load_scenario(path, overrides=()):
@@ -560,26 +706,102 @@ def sinusoid_sum(sinusoids, t, size):
     return out
 
 
+def wrap_angle(x):
+    """x wrapped to (-pi, pi]."""
+    return x - 2.0 * math.pi * np.ceil((x - math.pi) / (2.0 * math.pi))
+
+
+def target_heading(sc, x1, a1):
+    """The leader's heading psi, its exact rate psi' and where it is defined; (K,) arrays each.
+
+    psi = atan2(v_y, v_x) of the leader's velocity and psi' = (v_x a_y - v_y a_x) /
+    (v_x^2 + v_y^2) its time derivative, a1 the leader's true acceleration (m = k entries).
+    Defined where ||v|| >= min_speed (the whole velocity, as doc/math.md writes ||v_t||)
+    and the x-y part of v is not zero.
+    """
+    k = sc.k
+    vx, vy = x1[k], x1[k + 1]
+    vxy2 = vx * vx + vy * vy
+    speed = np.linalg.norm(x1[k:2 * k], axis=0)
+    defined = (speed >= sc.turning.min_speed) & (vxy2 > 0.0)
+    psi = np.arctan2(vy, vx)
+    psi_dot = (vx * a1[1] - vy * a1[0]) / np.where(vxy2 > 0.0, vxy2, 1.0)
+    return psi, psi_dot, defined
+
+
+def slot_heading_acceleration(tg, theta, theta_dot, psi, psi_dot, defined):
+    """theta'' of (T1) at every instant (continuous time, nothing held).
+
+    clamp(w^2 wrap(psi - theta) + 2 zeta w (psi' - theta'), +-beta), then no further
+    acceleration beyond |theta'| = max_yaw_rate. Where psi is undefined, psi := theta and
+    psi' := 0 (the slot stops turning and holds).
+    """
+    psi = np.where(defined, psi, theta)
+    psi_dot = np.where(defined, psi_dot, 0.0)
+    w, zeta = tg.natural_frequency, tg.damping
+    acc = w * w * wrap_angle(psi - theta) + 2.0 * zeta * w * (psi_dot - theta_dot)
+    acc = np.clip(acc, -tg.max_yaw_acceleration, tg.max_yaw_acceleration)
+    acc = np.where(theta_dot >= tg.max_yaw_rate, np.minimum(acc, 0.0), acc)
+    acc = np.where(theta_dot <= -tg.max_yaw_rate, np.maximum(acc, 0.0), acc)
+    return acc
+
+
+def turned_slot(sc, theta, theta_dot, theta_ddot):
+    """R(theta) d_p, the turned slot D of (T2) and u_r of (T3); (K,) arrays in.
+
+    R turns the x-y part of d_p by theta about z; J = [[0, -1], [1, 0]] on x-y, 0 on z:
+    D = [R d_p; theta' J R d_p], u_r = -(theta'' J + theta'^2 J^2) R d_p.
+    Returns (k, K), (n, K), (m, K) arrays.
+    """
+    k = sc.k
+    dp = sc.d[:k]
+    c, s = np.cos(theta), np.sin(theta)
+    r = np.tile(dp[:, None], (1, theta.size))                 # z part kept
+    r[0] = c * dp[0] - s * dp[1]
+    r[1] = s * dp[0] + c * dp[1]
+    jr = np.zeros_like(r)                                     # J R d_p
+    jr[0], jr[1] = -r[1], r[0]
+    jjr = np.zeros_like(r)                                    # J^2 R d_p
+    jjr[:2] = -r[:2]
+    D = np.vstack([r, theta_dot * jr])
+    ur = -(theta_ddot * jr + theta_dot * theta_dot * jjr)
+    return r, D, ur
+
+
 def closed_loop(sc, Z, u1, ud):
     """Every signal of the loop for K states at once.
 
-    Z is (3n, K) with rows [x_1; x_2; xi_hat]; u1 is (m, K), ud is (n, K).
+    Z is (3n, K) with rows [x_1; x_2; xi_hat], or (3n + 2, K) with rows [x_1; x_2; xi_hat;
+    theta; theta'] with turning slots; u1 is (m, K), ud is (n, K).
     Returns a namespace with the signals as (., K) arrays and zdot = dZ/dt.
     """
     n = sc.n
-    x1, x2, xh = Z[:n], Z[n:2 * n], Z[2 * n:]
-    xi = x1 - x2 - sc.d[:, None]
+    K = Z.shape[1]
+    x1, x2, xh = Z[:n], Z[n:2 * n], Z[2 * n:3 * n]
+    if sc.turning is not None:
+        theta, theta_dot = Z[3 * n], Z[3 * n + 1]
+        a_true = u1 + sc.B_pinv @ ud                   # the leader's true acceleration
+        psi, psi_dot, defined = target_heading(sc, x1, a_true)
+        theta_ddot = slot_heading_acceleration(sc.turning, theta, theta_dot,
+                                               psi, psi_dot, defined)
+        slot_p, D, ur = turned_slot(sc, theta, theta_dot, theta_ddot)
+    else:
+        D = sc.d[:, None]
+        ur = np.zeros((sc.m, K))
+    xi = x1 - x2 - D
     y = sc.C @ xi
     yh = sc.C @ xh
     if sc.tracker:
         ua = sc.Ge @ (y - yh) + sc.S21 @ yh
     else:
-        ua = np.zeros((sc.m, Z.shape[1]))
+        ua = np.zeros((sc.m, K))
     a1 = u1 + sc.B_pinv @ ud if sc.info_disturbance else u1   # leader acceleration told
     uff = a1 if sc.info_command else np.zeros_like(u1)
     ub = sc.G @ y
-    u2 = ub + ua + uff
+    u2 = ub + ua + uff + ur
 
+    # u_r is a known input, cancelled between plant and model: the estimator's
+    # augmentation is u_2 - G y - u_ff - u_r = u_a, so h is the pair's.
     h = sc.Ac @ xh - sc.B @ ua + sc.L @ (yh - y)
     if sc.info_estimator:
         h = h + sc.B @ (a1 - uff)
@@ -596,13 +818,17 @@ def closed_loop(sc, Z, u1, ud):
 
     x1_dot = sc.A @ x1 + sc.B @ u1 + ud
     x2_dot = sc.A @ x2 + sc.B @ u2
-    return SimpleNamespace(xi=xi, xi_hat=xh, x1=x1, x2=x2, u=u2, u_baseline=ub,
-                           u_tracker=ua, f=f, active=active,
-                           zdot=np.vstack([x1_dot, x2_dot, xh_dot]))
+    out = SimpleNamespace(xi=xi, xi_hat=xh, x1=x1, x2=x2, u=u2, u_baseline=ub,
+                          u_tracker=ua, f=f, active=active,
+                          zdot=np.vstack([x1_dot, x2_dot, xh_dot]))
+    if sc.turning is not None:
+        out.theta, out.theta_dot, out.theta_ddot = theta, theta_dot, theta_ddot
+        out.slot_p, out.u_slot = slot_p, ur
+        out.zdot = np.vstack([out.zdot, theta_dot, theta_ddot])
+    return out
 
 
-def initial_estimate(sc):
-    xi0 = sc.x1_0 - sc.x2_0 - sc.d
+def initial_estimate(sc, xi0):
     if sc.initial_estimate == "zero":
         return np.zeros(sc.n)
     est = np.linalg.pinv(sc.C) @ (sc.C @ xi0)
@@ -610,6 +836,25 @@ def initial_estimate(sc):
     if norm > sc.xi_max:
         est *= sc.xi_max / norm
     return est
+
+
+def initial_state(sc):
+    """z(0) = [x_1(0); x_2(0); xi_hat(0)], with turning slots also theta(0), theta'(0) = 0.
+
+    xi_0 = x_1(0) - x_2(0) - d from the scenario. With turning slots theta(0) = psi(0)
+    (0 if the leader starts below min_speed) and the follower starts at
+    x_1(0) - D(theta(0), 0) - xi_0: a follower on its world slot starts on its turned slot.
+    """
+    xi0 = sc.x1_0 - sc.x2_0 - sc.d
+    z = [sc.x1_0, sc.x2_0, initial_estimate(sc, xi0)]
+    if sc.turning is not None:
+        x1 = sc.x1_0[:, None]
+        psi, _, defined = target_heading(sc, x1, np.zeros((sc.m, 1)))
+        theta0 = float(psi[0]) if defined[0] else 0.0
+        _, D0, _ = turned_slot(sc, np.array([theta0]), np.zeros(1), np.zeros(1))
+        z[1] = sc.x1_0 - D0[:, 0] - xi0
+        z.append(np.array([theta0, 0.0]))
+    return np.concatenate(z)
 
 
 def time_grid(sc):
@@ -631,10 +876,13 @@ def segment_edges(sc):
 
 
 def simulate(sc, method="LSODA", rtol=1e-6, atol=1e-9, max_step=math.inf):
-    """Integrate the closed loop; return (grid, Z on the grid (3n, K), wall seconds, nfev)."""
+    """Integrate the closed loop; return (grid, Z on the grid, wall seconds, nfev).
+
+    Z is (3n, K), or (3n + 2, K) with turning slots (rows as in closed_loop()).
+    """
     grid = time_grid(sc)
-    Z = np.empty((3 * sc.n, grid.size))
-    z = np.concatenate([sc.x1_0, sc.x2_0, initial_estimate(sc)])
+    z = initial_state(sc)
+    Z = np.empty((z.size, grid.size))
     edges = segment_edges(sc)
     nfev = 0
     wall0 = time.perf_counter()
@@ -701,6 +949,14 @@ def signals_on_grid(sc, grid, Z):
             cols[f"{name}_{i}"] = arr[i]
     for i in range(n):
         cols[f"ud_{i}"] = ud[i]
+    if sc.turning is not None:
+        cols["slot_heading"] = s.theta
+        cols["slot_yaw_rate"] = s.theta_dot
+        cols["slot_yaw_acceleration"] = s.theta_ddot
+        for i in range(k):
+            cols[f"slot_p_{i}"] = s.slot_p[i]
+        for i in range(sc.m):
+            cols[f"u_slot_{i}"] = s.u_slot[i]
     return cols
 
 
@@ -743,6 +999,36 @@ def parse_args(argv):
     return ap.parse_args(argv)
 
 
+def follower_scenarios(sc):
+    """(name, scenario) per follower; name None for the pair without a formation section.
+
+    Every follower looks at the leader (a star, or a single follower), so each runs
+    the pair's loop on its own d_i and is simulated alone. It starts with the relative
+    error the scenario gives its single follower, xi_0 = x_1(0) - x_2(0) - d.
+    """
+    if sc.formation is None:
+        return [(None, sc)]
+    return [(f"follower_{i}", dataclasses.replace(sc, d=di, x2_0=sc.x2_0 + (sc.d - di)))
+            for i, di in enumerate(slot_layout(sc.formation, sc.d, sc.k), start=1)]
+
+
+def follower_csv_path(path, name):
+    """FILE with _<name> before its extension, as cf_sim names a formation's files."""
+    root, ext = os.path.splitext(path)
+    return f"{root}_{name}{ext}"
+
+
+def min_pair_separation(runs, k):
+    """Smallest distance between any two agents (the leader and the followers) on the grid."""
+    points = [np.vstack([runs[0][2][f"leader_p_{i}"] for i in range(k)])]
+    points += [np.vstack([cols[f"follower_p_{i}"] for i in range(k)]) for _, _, cols, _ in runs]
+    best = math.inf
+    for j in range(1, len(points)):
+        for i in range(j):
+            best = min(best, float(np.min(np.linalg.norm(points[j] - points[i], axis=0))))
+    return best
+
+
 def main(argv=None):
     args = parse_args(argv)
     try:
@@ -750,19 +1036,29 @@ def main(argv=None):
     except ScenarioError as exc:
         print(f"{PROG}: error: {exc}", file=sys.stderr)
         return 2
-    try:
-        grid, Z, wall, _ = simulate(sc, args.method, args.rtol, args.atol, args.max_step)
-    except (RuntimeError, ValueError) as exc:
-        print(f"{PROG}: error: {exc}", file=sys.stderr)
-        return 1
-    cols = signals_on_grid(sc, grid, Z)
-    if args.csv:
+    runs = []
+    for name, fsc in follower_scenarios(sc):
         try:
-            write_csv(args.csv, cols)
-        except OSError as exc:
-            print(f"{PROG}: error: cannot write {args.csv}: {exc.strerror}", file=sys.stderr)
+            grid, Z, wall, _ = simulate(fsc, args.method, args.rtol, args.atol, args.max_step)
+        except (RuntimeError, ValueError) as exc:
+            print(f"{PROG}: error: {name + ': ' if name else ''}{exc}", file=sys.stderr)
             return 1
-    print(" ".join(f"{key}={value:.9g}" for key, value in summary(sc, cols, wall).items()))
+        cols = signals_on_grid(fsc, grid, Z)
+        if args.csv:
+            path = follower_csv_path(args.csv, name) if name else args.csv
+            try:
+                write_csv(path, cols)
+            except OSError as exc:
+                print(f"{PROG}: error: cannot write {path}: {exc.strerror}", file=sys.stderr)
+                return 1
+        line = " ".join(f"{key}={value:.9g}" for key, value in summary(fsc, cols, wall).items())
+        print(f"{name} target=leader {line}" if name else line, flush=True)
+        runs.append((name, fsc, cols, wall))
+    if sc.formation is not None:
+        fm = sc.formation
+        print(f"formation followers={fm.followers} topology={fm.topology} shape={fm.shape} "
+              f"slots={fm.slots} min_pair_separation={min_pair_separation(runs, sc.k):.9g} "
+              f"wall_s={sum(r[3] for r in runs):.9g}")
     return 0
 
 
