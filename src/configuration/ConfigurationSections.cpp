@@ -143,6 +143,9 @@ FormationSpec readFormation(YamlReader& reader) {
         *value = turning.number(key);
       }
     }
+    if (turning.has("reversing")) {
+      heading.reversing = turning.boolean("reversing");
+    }
     turning.finish();
   }
   formation.finish();

@@ -63,6 +63,9 @@ SlotHeadingSample SlotHeading::tick(std::optional<double> heading) {
   }
   double heading_error = 0.0;  // wrap(psi - theta)
   double heading_rate = 0.0;   // psi', from the two latest headings
+  if (heading && parameters_.reversing && std::abs(wrapAngle(*heading - angle_)) > 0.5 * kPi) {
+    heading = wrapAngle(*heading + kPi);  // driving backward: its body points the other way
+  }
   if (heading) {
     heading_error = wrapAngle(*heading - angle_);
     if (previous_heading_) {

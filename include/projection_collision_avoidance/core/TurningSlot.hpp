@@ -25,6 +25,9 @@ struct SlotHeadingParameters {
   /// Below this target speed (m/s) the heading of a point-mass target (its velocity's direction)
   /// is undefined: theta stops turning (psi taken as theta, psi' as 0).
   double min_speed = 0.5;
+  /// The target may drive backward: a heading more than pi/2 from theta is taken as the target
+  /// reversing, psi + pi (the slot stays behind its body instead of swinging round it).
+  bool reversing = false;
 
   /// Throws ParameterError naming `<prefix>.natural_frequency` (not finite or <= 0), `.damping`
   /// (not finite or <= 0), `.max_yaw_rate`, `.max_yaw_acceleration` (not finite or <= 0) or
@@ -50,9 +53,10 @@ double wrapAngle(double angle);
 ///   theta'' = clamp(omega^2 wrap(psi - theta) + 2 zeta omega (psi' - theta'), +-beta),
 /// further limited so that |theta'| <= max_yaw_rate at the end of the period, held over the
 /// period; theta and theta' integrated exactly with it. psi' is the difference of the two latest
-/// headings over T (0 when either is missing). Without a heading (a target at rest, a heading
-/// not finite) psi = theta and psi' = 0: theta stops turning. theta is continuous and unwrapped;
-/// theta' is continuous. Allocates no memory.
+/// headings over T (0 when either is missing). With reversing, psi is first replaced by psi + pi
+/// when |wrap(psi - theta)| > pi/2 (a target driving backward). Without a heading (a target at
+/// rest, a heading not finite) psi = theta and psi' = 0: theta stops turning. theta is continuous
+/// and unwrapped; theta' is continuous. Allocates no memory.
 class SlotHeading {
  public:
   /// @param parameters validated
