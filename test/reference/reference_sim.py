@@ -74,10 +74,14 @@ writes FILE with _follower_<i> before its extension, per follower.
 The input and disturbance pulses make the right-hand side discontinuous in time,
 so the integration is restarted at every pulse edge. Inside a segment the
 right-hand side is Lipschitz (the projection term vanishes continuously at
-f = 0 and at grad_f^T h = 0), except with turning slots, where theta'' switches at
-|theta'| = max_yaw_rate, at ||v|| = min_speed and where psi - theta crosses +-pi; there
-the solver's error control shortens the steps (it converges: the summary of the figure
-eight moves by < 3e-7 m from rtol 1e-6 to 1e-9, with or without --max-step 0.01).
+f = 0 and at grad_f^T h = 0), except with turning slots. There theta'' switches where
+theta' reaches +-max_yaw_rate, and the yaw rate then slides on that surface; the solver
+would step to and fro across it (LSODA stalls), so the rate limit is a discrete mode and
+the integration is also restarted where it switches (terminal events,
+rate_limit_events()). Where ||v|| crosses min_speed and where psi - theta crosses
++-pi, theta'' jumps once, and the solver's error control crosses it (the summary of the
+figure eight, with the rate limit active for 63 of its 120 s, moves by < 3e-7 m from
+rtol 1e-6 to 1e-9).
 The solution is reported on the grid
 t_k = k / control_rate, k = 0 .. N with N = floor(duration * control_rate), the
 rows of the CSV of cf_sim; with turning slots the CSV adds cf_sim's columns
@@ -729,21 +733,31 @@ def target_heading(sc, x1, a1):
     return psi, psi_dot, defined
 
 
-def slot_heading_acceleration(tg, theta, theta_dot, psi, psi_dot, defined):
-    """theta'' of (T1) at every instant (continuous time, nothing held).
-
-    clamp(w^2 wrap(psi - theta) + 2 zeta w (psi' - theta'), +-beta), then no further
-    acceleration beyond |theta'| = max_yaw_rate. Where psi is undefined, psi := theta and
-    psi' := 0 (the slot stops turning and holds).
-    """
+def slot_heading_drive(tg, theta, theta_dot, psi, psi_dot, defined):
+    """theta'' of (T1) before the rate limit: clamp(w^2 wrap(psi - theta) + 2 zeta w (psi' -
+    theta'), +-beta), with psi := theta and psi' := 0 where psi is undefined (the slot stops
+    turning and holds)."""
     psi = np.where(defined, psi, theta)
     psi_dot = np.where(defined, psi_dot, 0.0)
     w, zeta = tg.natural_frequency, tg.damping
     acc = w * w * wrap_angle(psi - theta) + 2.0 * zeta * w * (psi_dot - theta_dot)
-    acc = np.clip(acc, -tg.max_yaw_acceleration, tg.max_yaw_acceleration)
-    acc = np.where(theta_dot >= tg.max_yaw_rate, np.minimum(acc, 0.0), acc)
-    acc = np.where(theta_dot <= -tg.max_yaw_rate, np.maximum(acc, 0.0), acc)
-    return acc
+    return np.clip(acc, -tg.max_yaw_acceleration, tg.max_yaw_acceleration)
+
+
+def rate_limit_mode(tg, theta_dot):
+    """+1 where theta' >= max_yaw_rate, -1 where theta' <= -max_yaw_rate, else 0."""
+    return np.where(theta_dot >= tg.max_yaw_rate, 1,
+                    np.where(theta_dot <= -tg.max_yaw_rate, -1, 0))
+
+
+def slot_heading_acceleration(drive, rate_mode):
+    """theta'' of (T1): the drive, with no further acceleration beyond the rate limit.
+
+    rate_mode +1 (theta' at +max_yaw_rate) allows theta'' <= 0 only, -1 theta'' >= 0 only,
+    0 (|theta'| below the limit) the drive as it is.
+    """
+    acc = np.where(rate_mode > 0, np.minimum(drive, 0.0), drive)
+    return np.where(rate_mode < 0, np.maximum(acc, 0.0), acc)
 
 
 def turned_slot(sc, theta, theta_dot, theta_ddot):
@@ -768,11 +782,13 @@ def turned_slot(sc, theta, theta_dot, theta_ddot):
     return r, D, ur
 
 
-def closed_loop(sc, Z, u1, ud):
+def closed_loop(sc, Z, u1, ud, rate_mode=None):
     """Every signal of the loop for K states at once.
 
     Z is (3n, K) with rows [x_1; x_2; xi_hat], or (3n + 2, K) with rows [x_1; x_2; xi_hat;
-    theta; theta'] with turning slots; u1 is (m, K), ud is (n, K).
+    theta; theta'] with turning slots; u1 is (m, K), ud is (n, K). rate_mode (turning slots)
+    is the rate limit's mode (slot_heading_acceleration()), a number or (K,); None: read
+    off theta' (rate_limit_mode()).
     Returns a namespace with the signals as (., K) arrays and zdot = dZ/dt.
     """
     n = sc.n
@@ -782,8 +798,10 @@ def closed_loop(sc, Z, u1, ud):
         theta, theta_dot = Z[3 * n], Z[3 * n + 1]
         a_true = u1 + sc.B_pinv @ ud                   # the leader's true acceleration
         psi, psi_dot, defined = target_heading(sc, x1, a_true)
-        theta_ddot = slot_heading_acceleration(sc.turning, theta, theta_dot,
-                                               psi, psi_dot, defined)
+        drive = slot_heading_drive(sc.turning, theta, theta_dot, psi, psi_dot, defined)
+        if rate_mode is None:
+            rate_mode = rate_limit_mode(sc.turning, theta_dot)
+        theta_ddot = slot_heading_acceleration(drive, rate_mode)
         slot_p, D, ur = turned_slot(sc, theta, theta_dot, theta_ddot)
     else:
         D = sc.d[:, None]
@@ -823,6 +841,7 @@ def closed_loop(sc, Z, u1, ud):
                           zdot=np.vstack([x1_dot, x2_dot, xh_dot]))
     if sc.turning is not None:
         out.theta, out.theta_dot, out.theta_ddot = theta, theta_dot, theta_ddot
+        out.theta_drive = drive
         out.slot_p, out.u_slot = slot_p, ur
         out.zdot = np.vstack([out.zdot, theta_dot, theta_ddot])
     return out
@@ -875,14 +894,46 @@ def segment_edges(sc):
     return sorted(edges)
 
 
-def simulate(sc, method="LSODA", rtol=1e-6, atol=1e-9, max_step=math.inf):
-    """Integrate the closed loop; return (grid, Z on the grid, wall seconds, nfev).
+def rate_limit_events(sc, mode, u1_at, ud):
+    """Terminal events that end a piece of constant rate-limit mode (turning slots).
 
-    Z is (3n, K), or (3n + 2, K) with turning slots (rows as in closed_loop()).
+    theta'' switches where theta' reaches +-max_yaw_rate and the drive still pushes on:
+    integrated as it is, the solver would step to and fro across that surface (the
+    slot's yaw rate slides on it). So the mode is a discrete state: in mode 0 the drive
+    acts unlimited and the pieces end where theta' reaches +-max_yaw_rate; in mode +-1
+    theta' stays at +-max_yaw_rate (theta'' = 0) until the drive turns back. Each piece's
+    right-hand side is then Lipschitz in the state (but for psi's switches, which the
+    solver's error control crosses).
+    """
+    rate = 3 * sc.n + 1
+    wmax = sc.turning.max_yaw_rate
+
+    def drive(t, z):
+        return closed_loop(sc, z[:, None], u1_at(t), ud, mode).theta_drive[0]
+
+    def event(fn, direction):
+        fn.terminal, fn.direction = True, direction
+        return fn
+
+    if mode == 0:
+        return [event(lambda t, z: z[rate] - wmax, 1.0), event(lambda t, z: z[rate] + wmax, -1.0)]
+    return [event(drive, -float(mode))]
+
+
+def simulate(sc, method="LSODA", rtol=1e-6, atol=1e-9, max_step=math.inf):
+    """Integrate the closed loop; return (grid, Z on the grid, rate_mode on the grid,
+    wall seconds, nfev).
+
+    Z is (3n, K), or (3n + 2, K) with turning slots (rows as in closed_loop()); rate_mode
+    (K,) is the rate limit's mode at each sample (0 without turning slots).
     """
     grid = time_grid(sc)
     z = initial_state(sc)
     Z = np.empty((z.size, grid.size))
+    modes = np.zeros(grid.size, dtype=int)
+    turning = sc.turning is not None
+    rate = 3 * sc.n + 1
+    mode = 0                                  # theta'(0) = 0: below the rate limit
     edges = segment_edges(sc)
     nfev = 0
     wall0 = time.perf_counter()
@@ -892,33 +943,57 @@ def simulate(sc, method="LSODA", rtol=1e-6, atol=1e-9, max_step=math.inf):
         ud = pulse_sum(sc.disturbances, mid, sc.n)
         sins = sc.sinusoids
 
-        def rhs(t, zz, u1_pulse=u1_pulse, ud=ud):
-            u1 = u1_pulse + sinusoid_sum(sins, t, sc.m) if sins else u1_pulse
-            return closed_loop(sc, zz[:, None], u1, ud).zdot[:, 0]
+        def u1_at(t, u1_pulse=u1_pulse):
+            return u1_pulse + sinusoid_sum(sins, t, sc.m) if sins else u1_pulse
 
         # Samples in [a, b); the last segment also takes a sample at b = duration.
         # The state is continuous, so an edge sample may come from either side.
         in_segment = (grid >= a) & ((grid < b) | (b == edges[-1]))
         idx = np.nonzero(in_segment)[0]
-        t_eval = grid[idx]
-        if t_eval.size == 0 or t_eval[-1] < b:
-            t_eval = np.append(t_eval, b)          # also ask for the end state
-        sol = solve_ivp(rhs, (a, b), z, method=method, t_eval=t_eval,
-                        rtol=rtol, atol=atol, max_step=max_step)
-        if not sol.success:
-            raise RuntimeError(f"integration failed on [{a:g}, {b:g}] s: {sol.message}")
-        nfev += sol.nfev
-        Z[:, idx] = sol.y[:, :idx.size]
-        z = sol.y[:, -1]
+        t0, done, stalled = a, 0, 0
+        while True:                           # pieces of constant rate-limit mode
+            def rhs(t, zz, mode=mode, ud=ud):
+                return closed_loop(sc, zz[:, None], u1_at(t), ud, mode).zdot[:, 0]
+
+            t_eval = grid[idx[done:]]
+            if t_eval.size == 0 or t_eval[-1] < b:
+                t_eval = np.append(t_eval, b)          # also ask for the end state
+            events = rate_limit_events(sc, mode, u1_at, ud) if turning else None
+            sol = solve_ivp(rhs, (t0, b), z, method=method, t_eval=t_eval, events=events,
+                            rtol=rtol, atol=atol, max_step=max_step)
+            if not sol.success:
+                raise RuntimeError(f"integration failed on [{t0:g}, {b:g}] s: {sol.message}")
+            nfev += sol.nfev
+            got = min(sol.t.size, idx.size - done)
+            Z[:, idx[done:done + got]] = sol.y[:, :got]
+            modes[idx[done:done + got]] = mode
+            done += got
+            if sol.status != 1:               # reached b
+                z = sol.y[:, -1]
+                break
+            # A rate-limit event ended the piece: switch the mode and go on from there.
+            fired = next(i for i, te in enumerate(sol.t_events) if te.size)
+            t_event, z = sol.t_events[fired][0], sol.y_events[fired][0].copy()
+            stalled = stalled + 1 if t_event - t0 <= 1e-12 * max(1.0, abs(t0)) else 0
+            if stalled > 100:
+                raise RuntimeError(f"the slot's rate limit switches without end at {t0:g} s")
+            t0 = t_event
+            if mode == 0:                     # theta' reached +-max_yaw_rate
+                z[rate] = math.copysign(sc.turning.max_yaw_rate, z[rate])
+                u1 = u1_at(t0)
+                drive = closed_loop(sc, z[:, None], u1, ud, 0).theta_drive[0]
+                mode = int(np.sign(z[rate])) if drive * z[rate] > 0.0 else 0
+            else:                             # the drive turned back
+                mode = 0
     wall = time.perf_counter() - wall0
-    return grid, Z, wall, nfev
+    return grid, Z, modes, wall, nfev
 
 
-def signals_on_grid(sc, grid, Z):
+def signals_on_grid(sc, grid, Z, rate_mode=None):
     """All CSV signals on the grid as a dict of column name -> 1-D array (in CSV order)."""
     u1 = pulse_sum(sc.input_pulses, grid, sc.m) + sinusoid_sum(sc.sinusoids, grid, sc.m)
     ud = pulse_sum(sc.disturbances, grid, sc.n)
-    s = closed_loop(sc, Z, u1, ud)
+    s = closed_loop(sc, Z, u1, ud, rate_mode)
     n, k = sc.n, sc.k
     K = grid.size
     cols = {"t": grid}
@@ -1039,11 +1114,12 @@ def main(argv=None):
     runs = []
     for name, fsc in follower_scenarios(sc):
         try:
-            grid, Z, wall, _ = simulate(fsc, args.method, args.rtol, args.atol, args.max_step)
+            grid, Z, modes, wall, _ = simulate(fsc, args.method, args.rtol, args.atol,
+                                               args.max_step)
         except (RuntimeError, ValueError) as exc:
             print(f"{PROG}: error: {name + ': ' if name else ''}{exc}", file=sys.stderr)
             return 1
-        cols = signals_on_grid(fsc, grid, Z)
+        cols = signals_on_grid(fsc, grid, Z, modes)
         if args.csv:
             path = follower_csv_path(args.csv, name) if name else args.csv
             try:
