@@ -29,7 +29,7 @@ a pair is. A case passes when
 The paper's runs and their variants run at 1 kHz. The turning-slot cases
 (``formation.slots: turning``, doc/math.md, "Turning slots" (T1)-(T3)) run the
 figure eights at their 100 Hz (one twin at 1 kHz) and run 2 in 2-D with a leader
-that drives a circle or reverses; cf_sim holds theta'' and u_r over a period and
+that drives a circle, reverses, or starts at rest; cf_sim holds theta'' and u_r over a period and
 differentiates the leader's heading by a difference quotient, so it differs from the
 continuous loop by O(T): ~0.02 m at 100 Hz (as world slots do there), ten times less
 at 1 kHz. Their tolerances (0.03 m at 100 Hz, 0.005 m at 1 kHz) and the measured
@@ -252,6 +252,13 @@ CASES = (
          note="run 2 in 2-D (-115 deg), the leader brakes below min_speed and reverses: "
               "the slot holds, then swings round at max_yaw_rate",
          tolerance=0.005),          # d = 0.0017 / 0.0022 / 0.0002
+    Case("turning_from_rest_run2", "paper_run2.yaml",
+         _TURNING + _rotated_2d(40.0) + (
+             "leader.input={pulses: [{start: 2.0, end: 6.0, vector: [-0.3, 0.4]}, "
+             "{start: 30.0, end: 36.0, vector: [0.3, -0.4]}]}",),
+         note="run 2 in 2-D (40 deg), the leader starts at rest (theta(0) = 0, no heading "
+              "before 3 s) and drives off at 126.9 deg; the push and a second pulse turn it",
+         tolerance=0.005),          # d = 0.0017 / 0.0022 / 0.0022
     Case("turning_v_star", "figure_eight_2d.yaml",
          ("formation.followers=4", "formation.topology=star", "formation.shape=v",
           "formation.slots=turning"),
