@@ -60,6 +60,8 @@ scenario puts it on its slot. In 3-D the threshold is on the whole speed ||v||, 
 doc/math.md writes it. Where cf_sim holds theta'' and u_r over a control period and
 takes psi' as a difference quotient, this is exact in time: the two agree to O(T).
 
+``formation.turning.reversing`` (cf_sim.md) is not in (T1): only ``false`` is accepted.
+
 Formations: a ``formation`` section (keys as cf_sim's) is covered when every follower
 looks at the leader, i.e. ``followers: 1`` (either topology) or ``topology: star``; a
 chain of more followers is refused (exit 2). Follower i runs the pair's loop on its own
@@ -172,6 +174,7 @@ SCHEMA = {
             "max_yaw_rate": None,
             "max_yaw_acceleration": None,
             "min_speed": None,
+            "reversing": None,
         },
     },
 }
@@ -488,6 +491,11 @@ def parse_formation(node, double_integrator, k):
     tnode = node.get("turning") or {}
     if not isinstance(tnode, dict):
         raise ScenarioError("formation.turning: expected a mapping")
+    # reversing (cf_sim.md) has no equation in doc/math.md's (T1): only its default is covered.
+    if as_bool(tnode.get("reversing", False), "formation.turning.reversing"):
+        raise ScenarioError(
+            "formation.turning.reversing = true: not covered by the reference, which "
+            "implements (T1) of doc/math.md (a reversing target swings the slot round)")
     values = {}
     for key, default in vars(Turning()).items():
         value = as_float(tnode.get(key, default), f"formation.turning.{key}")
