@@ -728,13 +728,13 @@ def target_heading(sc, x1, a1):
 
     psi = atan2(v_y, v_x) of the leader's velocity and psi' = (v_x a_y - v_y a_x) /
     (v_x^2 + v_y^2) its time derivative, a1 the leader's true acceleration (m = k entries).
-    Defined where ||v|| >= min_speed (the whole velocity, as doc/math.md writes ||v_t||)
-    and the x-y part of v is not zero.
+    Defined where the horizontal speed ||(v_x, v_y)|| >= min_speed (doc/math.md, (T1)) and is
+    not zero.
     """
     k = sc.k
     vx, vy = x1[k], x1[k + 1]
     vxy2 = vx * vx + vy * vy
-    speed = np.linalg.norm(x1[k:2 * k], axis=0)
+    speed = np.sqrt(vxy2)
     defined = (speed >= sc.turning.min_speed) & (vxy2 > 0.0)
     psi = np.arctan2(vy, vx)
     psi_dot = (vx * a1[1] - vy * a1[0]) / np.where(vxy2 > 0.0, vxy2, 1.0)
