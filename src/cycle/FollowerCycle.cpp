@@ -42,6 +42,10 @@ FollowerCycle::FollowerCycle(std::unique_ptr<DynamicFollowerController> controll
     throw std::invalid_argument("FollowerCycle: a controller and d of its state's size");
   }
   y_.resize(handover_.current().outputDimension());
+  slot_acceleration_.setZero(handover_.current().inputDimension());
+  if (settings_.turning) {
+    slot_heading_.emplace(*settings_.turning, period_);
+  }
 }
 
 FollowerCycle::~FollowerCycle() = default;
@@ -101,7 +105,10 @@ bool FollowerCycle::step(std::int64_t now_ns, std::int64_t stamp_ns, double dela
       ages, FollowerTimeouts{settings_.measurement_timeout, settings_.leader_timeout});
   out->stepped = false;
   out->mode = mode_;
-  if (mode_ == FollowerMode::kWaiting) {
+  const GenericDimensions::StateVector& state = inputs_.measurement().relative_state;
+  if (mode_ == FollowerMode::kWaiting || !turnSlot(stamp_ns, state, out)) {
+    mode_ = FollowerMode::kWaiting;
+    out->mode = mode_;
     fillCounters(now_ns, out);
     return false;
   }
@@ -114,8 +121,7 @@ bool FollowerCycle::step(std::int64_t now_ns, std::int64_t stamp_ns, double dela
   const bool use_leader = settings_.use_leader_input && out->leader_fresh;
   DynamicFollowerController& controller = handover_.current();
   const ControllerDesign& design = controller.design();
-  const GenericDimensions::StateVector& state = inputs_.measurement().relative_state;
-  out->xi = state - separation_;
+  out->xi = state - out->slot;
   const Eigen::Index axes = design.parameters.model.position_dimension;
   out->distance = state.head(axes).norm();
   // The time headway (S1) acts from the own state while it is fresh; without it the step runs
@@ -141,6 +147,9 @@ bool FollowerCycle::step(std::int64_t now_ns, std::int64_t stamp_ns, double dela
   if (use_leader) {
     inputs.leader_input.emplace(inputs_.leader().acceleration);
   }
+  if (slot_heading_) {
+    inputs.slot_acceleration.emplace(slot_acceleration_);
+  }
   const DynamicFollowerStatus* status = &controller.step(inputs);
   out->stepped = true;
   out->stamp_ns = stamp;
@@ -151,6 +160,37 @@ bool FollowerCycle::step(std::int64_t now_ns, std::int64_t stamp_ns, double dela
   out->leader_age = ages.leader_age;
   out->status = *status;
   fillCounters(now_ns, out);
+  return true;
+}
+
+bool FollowerCycle::turnSlot(std::int64_t stamp_ns, const GenericDimensions::StateVector& state,
+                             FollowerCycleOutput* out) {
+  out->slot = separation_;
+  out->heading_known = false;
+  if (!slot_heading_) {
+    return true;
+  }
+  const Eigen::Index axes = handover_.current().design().parameters.model.position_dimension;
+  const bool own_fresh = inputs_.ownStateAge(stamp_ns) <= settings_.measurement_timeout;
+  if (!heading_started_ && !own_fresh) {
+    return false;  // theta(0) comes from the target's first heading (or 0 without one)
+  }
+  std::optional<double> heading;
+  if (own_fresh && mode_ != FollowerMode::kMeasurementLost) {
+    // v_target = v_i + (v_target - v_i): the own odometry's velocity plus the measured one.
+    const auto& own = inputs_.ownState().state;
+    heading = velocityHeading(own(axes) + state(axes), own(axes + 1) + state(axes + 1),
+                              settings_.turning->min_speed);
+  }
+  if (!heading_started_) {
+    slot_heading_->reset(heading.value_or(0.0));
+    heading_started_ = true;
+  }
+  out->heading_known = heading.has_value();
+  out->slot_heading = slot_heading_->tick(heading);
+  turningSlotOffset(separation_, static_cast<int>(axes), out->slot_heading, &out->slot);
+  turningSlotAcceleration(separation_, static_cast<int>(axes), out->slot_heading,
+                          &slot_acceleration_);
   return true;
 }
 

@@ -5,11 +5,13 @@
 #include <limits>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <type_traits>
 #include <utility>
 
 #include "projection_collision_avoidance/core/DynamicFollowerController.hpp"
 #include "projection_collision_avoidance/core/FollowerMode.hpp"
+#include "projection_collision_avoidance/core/TurningSlot.hpp"
 #include "projection_collision_avoidance/core/TypeDefs.hpp"
 #include "projection_collision_avoidance/cycle/ControllerHandover.hpp"
 #include "projection_collision_avoidance/cycle/InputTimeline.hpp"
@@ -33,6 +35,9 @@ struct FollowerCycleSettings {
   bool use_leader_input = false;     ///< give the controller a fresh leader acceleration
   bool measurement_trigger = false;  ///< steps answer measurements (paced: StepPacer); ticks
                                      ///< only brake
+  /// Turning slots (formation.slots: turning): the slot heading's generator (T1); empty: d fixed
+  /// in the world.
+  std::optional<SlotHeadingParameters> turning;
 };
 
 /// What a tick or step gives the outputs: the step's results when one ran, and the counters.
@@ -53,9 +58,15 @@ struct FollowerCycleOutput {
   /// The step used the own state: a time headway is in force and the own odometry was younger
   /// than the measurement timeout at the stamp (else the headway is left out this step).
   bool own_state_fresh = false;
-  GenericDimensions::StateVector xi;  ///< x_target - x_i - d of the measurement used (m, m/s)
-  double distance = 0.0;              ///< ||p_target - p_i|| of that measurement (m)
-  DynamicFollowerStatus status;       ///< the controller's step
+  GenericDimensions::StateVector xi;  ///< x_target - x_i - D of the measurement used (m, m/s)
+  /// D: d, or with turning slots d turned by the slot heading (T2) (m, m/s)
+  GenericDimensions::StateVector slot;
+  SlotHeadingSample slot_heading;  ///< theta, theta', theta'' of a turning slot (T1); else 0
+  /// Turning slots: the step had the target's heading (own odometry and measurement fresh, the
+  /// target faster than formation.turning.min_speed); else the slot stopped turning
+  bool heading_known = false;
+  double distance = 0.0;         ///< ||p_target - p_i|| of that measurement (m)
+  DynamicFollowerStatus status;  ///< the controller's step
   // The design in force (filled with or without a step).
   double xi_max = 0.0;              ///< (1 - alpha) ||d|| in force (m)
   double xi_soft = 0.0;             ///< xi_max / sqrt(1 + epsilon) in force (m)
@@ -80,7 +91,10 @@ struct FollowerCycleOutput {
 /// ages, runs one step of the controller and fills a FollowerCycleOutput. With a time headway
 /// (time_headway > 0) a step with a measurement uses the own state while it is younger than the
 /// measurement timeout (StepInputs::own_state), else leaves the headway
-/// out. Nothing in tick() or stepOnMeasurement() allocates, locks (except under the measurement
+/// out. With turning slots (FollowerCycleSettings::turning) the slot turns with the heading of the
+/// target's velocity, its own (odometry) plus the measured relative velocity, (T1)-(T3): the first
+/// step waits for the own state, which sets theta(0). Nothing in tick() or stepOnMeasurement()
+/// allocates, locks (except under the measurement
 /// trigger, whose steps run in the measurement's callback, and a tick waits for a step running
 /// there) or makes a system call, so that a real-time thread can run it.
 ///
@@ -198,6 +212,11 @@ class FollowerCycle {
                    FollowerCycleOutput* out);
   bool stepOnLatchedMeasurement(std::int64_t now_ns, std::uint32_t skipped,
                                 FollowerCycleOutput* out);
+  /// D and u_r of this step into @p out and slot_acceleration_ (turning slots: from the heading
+  /// of the target's velocity when the own state is fresh at @p stamp_ns); false when the first
+  /// step must wait for the own state.
+  bool turnSlot(std::int64_t stamp_ns, const GenericDimensions::StateVector& state,
+                FollowerCycleOutput* out);
   /// The counters and the design in force into @p out (whether or not a step ran).
   void fillCounters(std::int64_t now_ns, FollowerCycleOutput* out) const;
   /// Notes ROS time @p now_ns: a jump back is counted, and the stamps start afresh.
@@ -206,6 +225,9 @@ class FollowerCycle {
   ControllerHandover handover_;  ///< the controller in force, and a new design's
   GenericDimensions::StateVector separation_;
   FollowerCycleSettings settings_;
+  std::optional<SlotHeading> slot_heading_;           ///< theta (T1) of a turning slot
+  bool heading_started_ = false;                      ///< theta(0) set by the first step
+  GenericDimensions::InputVector slot_acceleration_;  ///< u_r (T3) of the step
   double period_ = 0.0;
   std::mutex trigger_mutex_;  ///< measurement trigger only: callback steps vs braking ticks
   LatchedInputs inputs_;

@@ -51,7 +51,7 @@ void FollowerInputs::start(ros::NodeHandle node) {
   }
   leader_subscriber_ =
       nh.subscribe("leader_broadcast", 10, &FollowerInputs::onLeaderBroadcast, this, link);
-  if (design_.parameters.time_headway > 0.0) {
+  if (design_.parameters.time_headway > 0.0 || options_.turning) {
     odometry_subscriber_ = nh.subscribe("odom", 10, &FollowerInputs::onOdometry, this,
                                         ros::TransportHints().tcpNoDelay());
   }

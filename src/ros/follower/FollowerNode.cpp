@@ -30,8 +30,11 @@ FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh,
   auto controller =
       std::make_unique<DynamicFollowerController>(ControllerDesign::create(parameters));
   const ControllerDesign& design = controller->design();
-  const FollowerNodeOptions options =
+  FollowerNodeOptions options =
       readFollowerOptions(reader, parameters, member, ros::Time::isSimTime());
+  if (configuration.formation.slots == SlotFrame::kTurning) {
+    options.turning = configuration.formation.turning;
+  }
   if (options.lock_memory) {
     try {
       lockProcessMemory();
@@ -52,6 +55,7 @@ FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh,
   settings.leader_timeout = options.leader_timeout;
   settings.use_leader_input = options.use_leader_broadcast;
   settings.measurement_trigger = options.trigger == ControlTrigger::kMeasurement;
+  settings.turning = options.turning;
   const ControllerDesign start = design;
   cycle_ = std::make_unique<FollowerCycle>(std::move(controller), parameters.separation, settings);
   try {
@@ -110,7 +114,10 @@ FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh,
                        << (parameters.time_headway > 0.0
                                ? ", time headway " + std::to_string(parameters.time_headway) +
                                      " s from " + inputs_->odometryTopic()
-                               : std::string()));
+                               : std::string())
+                       << (options.turning ? ", turning slot (heading from " +
+                                                 inputs_->odometryTopic() + " and the measurement)"
+                                           : std::string()));
 }
 
 FollowerNode::~FollowerNode() { stop(); }

@@ -123,11 +123,6 @@ PositionInputOptions readPositionOptions(NodeOptionReader& reader, MeasurementIn
 /// Member ~formation_index of the configured formation.
 FormationMember memberOf(NodeOptionReader& reader, const FollowerConfiguration& configuration) {
   const int index = reader.integer("formation_index", 1, 1, FormationSpec::kMaxFollowers);
-  if (configuration.formation.slots != SlotFrame::kWorld) {
-    throw ParameterError("~scenario/formation/slots",
-                         "turning slots run in cf_sim only so far; the follower node keeps world "
-                         "slots (doc/formations.md, \"Turning formations\")");
-  }
   return configuration.member(index, "~formation_index");
 }
 

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include "projection_collision_avoidance/core/ControllerParameters.hpp"
@@ -101,6 +102,10 @@ struct FollowerNodeOptions {
   /// the control rate by default (every step); 0: none
   double status_rate = 0.0;
   int formation_index = 1;  ///< i: which follower of the scenario's formation this is
+  /// The scenario's formation.turning with formation.slots: turning (the slot turns with the
+  /// heading of the target's velocity, from the own odometry `odom` and the measurement); empty:
+  /// world slots.
+  std::optional<SlotHeadingParameters> turning;
   /// ~trigger: "timer" (default) or "measurement"; see FollowerNode.
   ControlTrigger trigger = ControlTrigger::kTimer;
   /// ~control_loop: "timer" (default) or "thread" (wall time only); see FollowerNode.

@@ -46,6 +46,11 @@ FollowerStatus toStatusMsg(const FollowerCycleOutput& out, const FollowerInputSt
   msg.headway_command = toStdVector(s.headway_command);
   msg.own_state_fresh = out.own_state_fresh;
   msg.fallback_command = toStdVector(s.fallback_command);
+  msg.slot = toStdVector(out.slot);
+  msg.slot_heading = out.slot_heading.angle;
+  msg.slot_yaw_rate = out.slot_heading.rate;
+  msg.heading_known = out.heading_known;
+  msg.slot_command = toStdVector(s.slot_command);
   msg.distance = out.distance;
   msg.perimeter = out.perimeter;
   msg.ticks = out.steps;
