@@ -177,9 +177,9 @@ bool FollowerCycle::turnSlot(std::int64_t stamp_ns, const GenericDimensions::Sta
   }
   std::optional<double> heading;
   if (own_fresh && mode_ != FollowerMode::kMeasurementLost) {
-    // v_target = v_i + (v_target - v_i): the own odometry's velocity plus the measured one.
-    const auto& own = inputs_.ownState().state;
-    heading = velocityHeading(own(axes) + state(axes), own(axes + 1) + state(axes + 1),
+    // v_target = v_i + (v_target - v_i): the own controlled point's velocity plus the measured.
+    const auto& own = inputs_.ownState().controlled_velocity;
+    heading = velocityHeading(own(0) + state(axes), own(1) + state(axes + 1),
                               settings_.turning->min_speed);
   }
   if (!heading_started_) {

@@ -52,6 +52,7 @@ OwnStateSample ownStateAt(std::int64_t stamp_ns, std::uint64_t sequence, double 
   own.sequence = sequence;
   own.state.setZero(4);
   own.state << 0.0, 0.0, speed * std::cos(heading), speed * std::sin(heading);
+  own.controlled_velocity = own.state.tail(2);
   return own;
 }
 

@@ -30,6 +30,10 @@ struct OwnStateSample {
   std::int64_t receipt_ns = 0;
   std::uint64_t sequence = 0;
   GenericDimensions::StateVector state;  ///< x_i (m, m/s)
+  /// The velocity of the follower's controlled point, the point the relative measurement is of
+  /// (the origin's, or a look-ahead point's) (m/s, one entry per axis): with the measured relative
+  /// velocity, the target's (turning slots).
+  GenericDimensions::InputVector controlled_velocity;
 };
 
 /// The follower's input slots, lock-free triple buffers (LatestValue) that the input callbacks

@@ -32,6 +32,7 @@ FollowerInputs::FollowerInputs(std::string node_name, const FollowerNodeOptions&
   measurement_.relative_state.setZero(2 * axes_);
   leader_.acceleration.setZero(axes_);
   own_state_.state.setZero(2 * axes_);
+  own_state_.controlled_velocity.setZero(axes_);
   relative_state_ = Eigen::VectorXd::Zero(2 * axes_);
   odometry_state_ = Eigen::VectorXd::Zero(2 * axes_);
 }
@@ -209,6 +210,21 @@ void FollowerInputs::onOdometry(const ros::MessageEvent<nav_msgs::Odometry const
       return;
     }
     odometry_state_ = origin_state_;
+    own_state_.controlled_velocity = origin_state_.tail(axes_);
+    const double look_ahead =
+        options_.input == MeasurementInput::kOdometry              ? options_.odometry.look_ahead
+        : options_.input == MeasurementInput::kRelativeMeasurement ? 0.0
+                                                                   : options_.position.look_ahead;
+    if (options_.turning && look_ahead > 0.0) {
+      // The look-ahead point, which the relative measurement (~input odometry, tf or position) is
+      // taken at.
+      const Eigen::Matrix<double, 6, 1> point = bodyPointState(
+          toOdometrySample(*msg), Eigen::Vector3d(look_ahead, 0.0, 0.0),
+          options_.odometry.twist_in_body_frame ? TwistFrame::kBody : TwistFrame::kWorld);
+      if (point.allFinite()) {
+        own_state_.controlled_velocity = point.segment(3, axes_);
+      }
+    }
     own_state_.stamp_ns = timeline.accept();
     own_state_.receipt_ns = nanosecondsOf(now);
     own_state_.sequence = timeline.guard().accepted();
