@@ -11,7 +11,9 @@ chain of 10, with formation.slots world, turning, and turning with formation.tur
   turning_paths.png        paths with headings (arrows along the leader's path, grey dots: every
                            agent's place every 5 s), world-fixed beside turning
 The distance from the leader's path is that of each follower position (every tick) to the
-nearest leader position of the whole run (positions 2 cm apart at 2 m/s and 100 Hz).
+nearest point of the leader's path: its positions over the whole run (2 cm apart at 2 m/s and
+100 Hz), and the road it came on, 80 m straight behind its first position against its initial
+velocity, on which the followers start.
 Usage: turning_table.py CF_SIM OUT_DIR
 """
 
@@ -59,6 +61,15 @@ def columns(path, prefix, k=2):
     return np.column_stack([data[f"{prefix}{i}"] for i in range(k)]), data
 
 
+def road_behind(start, data, length=80.0, spacing=0.02):
+    """The road the leader came on: LENGTH m straight behind its first position, against its
+    initial velocity (its followers start on it)."""
+    velocity = np.array([data["leader_v_0"][0], data["leader_v_1"][0]])
+    direction = velocity / np.linalg.norm(velocity)
+    s = np.arange(spacing, length, spacing)
+    return start[None, :] - s[:, None] * direction[None, :]
+
+
 def main():
     cf_sim, out = sys.argv[1], Path(sys.argv[2])
     rows = []
@@ -78,8 +89,8 @@ def main():
                         f = base.with_name(f"{base.stem}_follower_{i}{base.suffix}")
                         own, data = columns(f, "follower_p_")
                         if i == 1:
-                            leader, _ = columns(f, "leader_p_")
-                            tree = cKDTree(leader)
+                            leader, data = columns(f, "leader_p_")
+                            tree = cKDTree(np.vstack([road_behind(leader[0], data), leader]))
                         stray, _ = tree.query(own)
                         s = followers[f"follower_{i}"]
                         xi_max = float(s["xi_max"])
