@@ -163,7 +163,7 @@ def plot(paths, path):
                 ax.plot([leader[j, 0]] + [p[j, 0] for p in followers],
                         [leader[j, 1]] + [p[j, 1] for p in followers], "o", ms=3, color="grey")
             ax.set_title(f"{scenario}, {formation}: {frame} slots")
-            ax.set_aspect("equal")
+            ax.set_aspect("equal", adjustable="datalim")
             ax.grid(True, alpha=0.3)
             ax.set_xlabel("x (m)")
             ax.set_ylabel("y (m)")
