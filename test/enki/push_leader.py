@@ -21,6 +21,7 @@ Private parameters (defaults in brackets):
   ~push_accel  m/s^2, negative = backwards [-0.02]
   ~push_scale  factor on push_accel [1]
   ~hold        s the reached speed is held after the push [2]
+  ~yaw_rate    rad/s, the robot's turn throughout (angular.z; a circle of radius speed / yaw_rate) [0]
   ~rate        Hz of the published commands [50]
   ~duration    s after the start to publish a zero command and exit; 0 = run forever [0]
   ~wait_for_subscriber  start the profile (t = 0) only once cmd_vel has a subscriber [true]
@@ -66,6 +67,7 @@ def main():
         push_end=float(rospy.get_param("~push_end", 23.0)),
         accel=float(rospy.get_param("~push_accel", -0.02)) * float(rospy.get_param("~push_scale", 1.0)),
         hold=float(rospy.get_param("~hold", 2.0)))
+    yaw_rate = float(rospy.get_param("~yaw_rate", 0.0))
     rate_hz = float(rospy.get_param("~rate", 50.0))
     duration = float(rospy.get_param("~duration", 0.0))
     pub = rospy.Publisher(robot + "/cmd_vel", Twist, queue_size=1)
@@ -76,8 +78,9 @@ def main():
     while not rospy.is_shutdown() and rospy.Time.now().is_zero():
         time.sleep(0.01)  # /use_sim_time and no /clock yet
     start = rospy.Time.now()
-    rospy.loginfo("push_leader: %s at %.3f m/s, push %.3f m/s^2 from %.1f s to %.1f s, v_push %.3f m/s",
-                  robot, profile.speed, profile.accel, profile.t0, profile.t1, profile.v_push)
+    rospy.loginfo("push_leader: %s at %.3f m/s turning at %.3f rad/s, push %.3f m/s^2 from %.1f s "
+                  "to %.1f s, v_push %.3f m/s", robot, profile.speed, yaw_rate, profile.accel,
+                  profile.t0, profile.t1, profile.v_push)
     rospy.on_shutdown(lambda: pub.publish(Twist()))  # best effort: the bridge holds commands
 
     rate = rospy.Rate(rate_hz)
@@ -88,6 +91,7 @@ def main():
             break
         cmd = Twist()
         cmd.linear.x = profile(t)
+        cmd.angular.z = yaw_rate
         pub.publish(cmd)
         try:
             rate.sleep()

@@ -7,7 +7,9 @@ sensor whose frames carry a leading slash (at 100 Hz, past the leader's push); o
 robot of ~followed_robots (default robot_1) moves (its ground truth at least ~min_travel m from
 its start: the adapter's cmd_vel reaches it), and no two robots of ~robots (default robot_0,
 robot_1) come closer than ~min_centre_distance m centre to centre (ground truth; two Thymios
-touch at about 0.11 m).
+touch at about 0.11 m). With ~behind_leader (a turning leader and turning slots), each followed
+robot ends behind the leader's heading: in the leader's body frame (its ground-truth yaw), at
+least ~behind_margin m behind it.
 """
 
 import itertools
@@ -32,6 +34,7 @@ class EnkiPair(unittest.TestCase):
         self.moving = list(rospy.get_param("~followed_robots", ["robot_1"]))
         self.tracking = {name: 0 for name in self.followers}
         self.truth = {}
+        self.yaw = {}
         self.start = {}
         self.min_distance = {pair: math.inf for pair in itertools.combinations(self.robots, 2)}
         self.travel = {robot: 0.0 for robot in self.robots}
@@ -49,8 +52,10 @@ class EnkiPair(unittest.TestCase):
 
     def on_truth(self, msg, robot):
         p = msg.pose.pose.position
+        q = msg.pose.pose.orientation
         with self.lock:
             self.truth[robot] = (p.x, p.y)
+            self.yaw[robot] = math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
             sx, sy = self.start.setdefault(robot, (p.x, p.y))
             self.travel[robot] = max(self.travel[robot], math.hypot(p.x - sx, p.y - sy))
             for pair in self.min_distance:
@@ -81,6 +86,7 @@ class EnkiPair(unittest.TestCase):
                       f"a follower has fewer than {min_statuses} tracking statuses")
         with self.lock:
             tracking, travel, distance = dict(self.tracking), dict(self.travel), dict(self.min_distance)
+            truth, yaw = dict(self.truth), dict(self.yaw)
         print("enki: tracking statuses %s, travelled %s m, closest centres %s m" % (
             tracking, {r: round(travel[r], 3) for r in self.moving},
             {"-".join(p): round(d, 3) for p, d in distance.items()}), flush=True)
@@ -88,6 +94,16 @@ class EnkiPair(unittest.TestCase):
             self.assertGreater(travel[robot], min_travel, f"{robot} did not move: no cmd_vel reached it")
         for pair, d in distance.items():
             self.assertGreater(d, min_centre, "%s and %s came too close" % pair)
+        if rospy.get_param("~behind_leader", False):
+            margin = float(rospy.get_param("~behind_margin", 0.1))
+            leader = self.robots[0]
+            (lx, ly), heading = truth[leader], yaw[leader]
+            for robot in self.moving:
+                dx, dy = truth[robot][0] - lx, truth[robot][1] - ly
+                ahead = math.cos(heading) * dx + math.sin(heading) * dy  # along the leader's heading
+                print("enki: %s at %.3f m along %s's heading (%.2f rad)" % (robot, ahead, leader, heading),
+                      flush=True)
+                self.assertLess(ahead, -margin, f"{robot} is not behind {leader}'s heading")
 
 
 if __name__ == "__main__":
