@@ -12,8 +12,10 @@
 #                                 side view in a 1280x420 window (rviz/formation_line.rviz)
 #   doc/rviz_vehicles.png         vehicles.launch: 3 differential-drive followers on odometry and
 #                                 cmd_vel, star, V, t = 21.5 s (during the push), formation.rviz
-# Usage: experiments/formation_screenshots/run.sh [2d] [3d] [chain] [vehicles]
-#   (default: all four; ~1 min each)
+#   doc/rviz_formation_turning.png  figure_eight_2d, 4 followers, star, V, slots:=turning,
+#                                 t = 13 s (the leader turning round a loop), formation.rviz
+# Usage: experiments/formation_screenshots/run.sh [2d] [3d] [chain] [vehicles] [turning]
+#   (default: all five; ~1 min each)
 #   OUT_DIR (default doc/), REAL_TIME_FACTOR (default 0.5), ROS_PORT (default 11412: its own
 #   master, apart from other tests), SCREEN_DISPLAY (default :98). Needs a built workspace
 #   (scripts/build.sh). The PNGs are reduced to 256 colours (ImageMagick `convert`).
@@ -23,7 +25,7 @@ out=${OUT_DIR:-$root/doc}
 rtf=${REAL_TIME_FACTOR:-0.5}
 port=${ROS_PORT:-11412}
 shots=("$@")
-(( ${#shots[@]} )) || shots=(2d 3d chain vehicles)
+(( ${#shots[@]} )) || shots=(2d 3d chain vehicles turning)
 launch=formation.launch  # the launch file of the current shot
 test -f "$root/build/devel/setup.bash" || "$root/scripts/build.sh" >/dev/null
 set +u  # the workspace's setup scripts read unset variables
@@ -107,9 +109,12 @@ for shot in "${shots[@]}"; do
     chain) shoot 22 "$out/rviz_formation_chain.png" "$root/rviz/formation_line.rviz" \
           scenario:="$root/config/scenarios/paper_run2.yaml" followers:=5 topology:=chain \
           shape:=line control_rate:=100 ;;
+    turning) shoot 13 "$out/rviz_formation_turning.png" "$root/rviz/formation.rviz" \
+          scenario:="$root/config/scenarios/figure_eight_2d.yaml" followers:=4 topology:=star \
+          shape:=v slots:=turning ;;
     vehicles) launch=vehicles.launch
           shoot 21.5 "$out/rviz_vehicles.png" "$root/rviz/formation.rviz" followers:=3 kind:=unicycle
           launch=formation.launch ;;
-    *) echo "formation_screenshots: unknown shot '$shot' (2d, 3d, chain, vehicles)"; exit 1 ;;
+    *) echo "formation_screenshots: unknown shot '$shot' (2d, 3d, chain, vehicles, turning)"; exit 1 ;;
   esac
 done
