@@ -46,6 +46,7 @@ DynamicFollowerController::DynamicFollowerController(const ControllerDesign& des
   status_.feedforward_command.setZero(m);
   status_.headway_command.setZero(m);
   status_.fallback_command.setZero(m);
+  status_.slot_command.setZero(m);
   status_.estimate.setZero(n);
 }
 

@@ -31,15 +31,17 @@ template <typename DimsA, typename DimsB>
 void expectSameStatus(const FollowerControllerStatus<DimsA>& a,
                       const FollowerControllerStatus<DimsB>& b, double tolerance) {
   const auto& [command, baseline_command, tracker_command, feedforward_command, headway_command,
-               fallback_command, estimate, estimate_norm, constraint_value, command_saturated,
-               command_rate_limited, fallback, projection_active, boundary_correction,
-               measurement_rejected, leader_input_rejected, command_overflow, estimate_held] = a;
+               fallback_command, slot_command, estimate, estimate_norm, constraint_value,
+               command_saturated, command_rate_limited, fallback, projection_active,
+               boundary_correction, measurement_rejected, leader_input_rejected,
+               slot_acceleration_rejected, command_overflow, estimate_held] = a;
   EXPECT_MATRIX_NEAR(command, b.command, tolerance);
   EXPECT_MATRIX_NEAR(baseline_command, b.baseline_command, tolerance);
   EXPECT_MATRIX_NEAR(tracker_command, b.tracker_command, tolerance);
   EXPECT_MATRIX_NEAR(feedforward_command, b.feedforward_command, tolerance);
   EXPECT_MATRIX_NEAR(headway_command, b.headway_command, tolerance);
   EXPECT_MATRIX_NEAR(fallback_command, b.fallback_command, tolerance);
+  EXPECT_MATRIX_NEAR(slot_command, b.slot_command, tolerance);
   EXPECT_MATRIX_NEAR(estimate, b.estimate, tolerance);
   EXPECT_NEAR(estimate_norm, b.estimate_norm, tolerance);
   EXPECT_NEAR(constraint_value, b.constraint_value, tolerance);
@@ -50,6 +52,7 @@ void expectSameStatus(const FollowerControllerStatus<DimsA>& a,
   EXPECT_NEAR(boundary_correction, b.boundary_correction, tolerance);
   EXPECT_EQ(measurement_rejected, b.measurement_rejected);
   EXPECT_EQ(leader_input_rejected, b.leader_input_rejected);
+  EXPECT_EQ(slot_acceleration_rejected, b.slot_acceleration_rejected);
   EXPECT_EQ(command_overflow, b.command_overflow);
   EXPECT_EQ(estimate_held, b.estimate_held);
 }
@@ -94,6 +97,31 @@ TEST(DynamicFollowerController, OwnStateAndSharedInputMatchTheFixedSizeControlle
     ASSERT_FALSE(HasFailure());
   }
   EXPECT_GT(runtime.status().headway_command.norm(), 0.0);
+}
+
+TEST(DynamicFollowerController, TheSlotAccelerationMatchesTheFixedSizeController) {
+  const ControllerDesign design = ControllerDesign::create(
+      loadScenarioFile(testing::scenarioPath("figure_eight_2d.yaml")).controller);
+  DynamicFollowerController runtime(design);
+  FollowerController<DoubleIntegrator2D> fixed(design);
+  for (int k = 0; k < 300; ++k) {
+    SCOPED_TRACE(::testing::Message() << "step " << k);
+    const Eigen::Vector4d y(0.01 * k, -0.5, std::sin(0.1 * k), 0.2);
+    const Eigen::Vector2d slot(std::cos(0.05 * k), std::sin(0.05 * k));
+    DynamicStepInputs dynamic{y};
+    StepInputs<DoubleIntegrator2D> inputs{y};
+    if (k % 4 != 0) {  // u_r given on three steps of four, a step without a measurement each 7
+      dynamic.slot_acceleration.emplace(slot);
+      inputs.slot_acceleration = slot;
+    }
+    if (k % 7 == 3) {
+      dynamic.measurement.reset();
+      inputs.measurement.reset();
+    }
+    expectSameStatus(runtime.step(dynamic), fixed.step(inputs), 0.0);
+    ASSERT_FALSE(HasFailure());
+  }
+  EXPECT_GT(runtime.status().slot_command.norm(), 0.0);
 }
 
 /// How often each condition held over a run (statuses of the run-time controller).
