@@ -67,7 +67,10 @@ build_sanitized() {
 
 phase "sanitizers: gtests"
 rm -rf "$build_dir/test_results"
-(cd "$build_dir" && ctest -j"${JOBS:-2}" --output-on-failure) || {
+# Every core gtest but the chain of 100 at 1 kHz: 231 s of 727 under ASan, it runs the code of
+# the chain at 100 Hz (run here) ten times as long; the plain build runs it (test_string_stability).
+(cd "$build_dir" && ctest -j"${JOBS:-2}" --output-on-failure \
+  -E '^StringStability\.ChosenConfigurationHoldsAChainOf100At1kHz$') || {
   echo "sanitize: core gtests failed"
   exit 1
 }
