@@ -236,25 +236,35 @@ class HostileSenders(unittest.TestCase):
                       "input_handovers %s", sent, largest, worst, foreign["foreign_messages"],
                       foreign["input_handovers"])
 
-    def recovery(self, name, forged_at, timeout, age_field, fresh_field, what):
-        """Simulated s from the forged message to the end of the last tick of `name` not tracking
-        on fresh input (mode tracking, the input's age below ~fresh_age), over the timeout plus
-        ~recovery_margin and ~observe_after after it; 0 when there is none. Asserts ticks after
-        it."""
-        fresh_age = rospy.get_param("~fresh_age")
+    def recovery(self, name, forged_at, timeout, fresh_field, count_field, what):
+        """Simulated s from the forged message to the end of the last tick of `name` that was not
+        tracking on fresh input (mode tracking and `fresh_field`: the input younger than its
+        timeout) or at which the input's own sender was refused (`count_field`, the refusal
+        count, grew beyond the forged message itself), over the timeout plus ~recovery_margin and
+        ~observe_after after it; 0 when there is none. A lock-out refuses the sender's messages;
+        a late one (the test's relay under load) is neither refused nor, within the timeout,
+        stale. Asserts ticks after it."""
         window = timeout + rospy.get_param("~recovery_margin") + rospy.get_param("~observe_after")
         self.wait_for(lambda: (self.senders.latest(name)[0] or 0.0) >= forged_at + window,
                       f"{name}: no ticks {window} s after {what}")
+        earlier = self.senders.since(name, 0.0, forged_at)
+        self.assertTrue(earlier, f"{name}: no tick before {what}")
+        counted = getattr(earlier[-1], count_field)
         statuses = self.senders.since(name, forged_at, forged_at + window)
-        bad = [seconds(s.header.stamp) for s in statuses
-               if not (s.mode == FollowerStatus.MODE_TRACKING and getattr(s, fresh_field) and
-                       getattr(s, age_field) < fresh_age)]
+        bad = []
+        for status in statuses:
+            count = getattr(status, count_field)
+            refused = count > counted and count - getattr(earlier[-1], count_field) > 1
+            counted = count
+            if refused or not (status.mode == FollowerStatus.MODE_TRACKING and
+                               getattr(status, fresh_field)):
+                bad.append(status)
         if bad:
-            rospy.loginfo("hostile_senders: %s after %s: not tracking on fresh input at %s", name,
-                          what, [(round(seconds(s.header.stamp) - forged_at, 3), s.mode,
-                                  round(getattr(s, age_field), 3)) for s in statuses
-                                 if seconds(s.header.stamp) in bad][:40])
-        last = max(bad, default=forged_at)
+            rospy.loginfo("hostile_senders: %s after %s: refusing or not tracking on fresh input "
+                          "at %s", name, what,
+                          [(round(seconds(s.header.stamp) - forged_at, 3), s.mode,
+                            getattr(s, count_field)) for s in bad][:40])
+        last = max((seconds(s.header.stamp) for s in bad), default=forged_at)
         after = [s for s in statuses if seconds(s.header.stamp) > last]
         self.assertGreater(len(after), 10, f"{name}: too few ticks after {what}")
         period = seconds(after[1].header.stamp) - seconds(after[0].header.stamp)
@@ -274,8 +284,8 @@ class HostileSenders(unittest.TestCase):
         margin = rospy.get_param("~recovery_margin")
         times = {}
         for name in RELAYS:
-            fields = (("measurement_age", "measurement_fresh") if kind == "measurement" else
-                      ("leader_age", "leader_fresh"))
+            fields = (("measurement_fresh", "rejected_measurements") if kind == "measurement" else
+                      ("leader_fresh", "rejected_leader_broadcasts"))
             times[name] = self.recovery(name, forged_at, timeout, *fields,
                                         f"a {kind} {ahead} s ahead")
             self.assertLessEqual(times[name], timeout + margin,
