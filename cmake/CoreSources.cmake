@@ -6,6 +6,7 @@
 set(PCA_CORE_SOURCES
   src/core/AgentModel.cpp
   src/core/ControllerDesign.cpp
+  src/core/ConvoyReference.cpp
   src/core/DynamicFollowerController.cpp
   src/core/ExactDiscretization.cpp
   src/core/FollowerController.cpp
@@ -13,6 +14,7 @@ set(PCA_CORE_SOURCES
   src/core/Formation.cpp
   src/core/LinearAlgebra.cpp
   src/core/PlatoonLaws.cpp
+  src/core/TargetPath.cpp
   src/core/TurningSlot.cpp
 )
 

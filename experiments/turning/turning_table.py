@@ -3,7 +3,8 @@
 
 Runs cf_sim on config/scenarios/{figure_eight_2d,turning_circle,turning_u_turn,
 turning_stop_and_go}.yaml (each with the paper's push) for a pair, a V star of 4 and a line
-chain of 10, with formation.slots world, turning, and turning with formation.turning.reversing, and writes to OUT_DIR:
+chain of 10, with formation.slots world, turning, turning with formation.turning.reversing, and path (a
+convoy: the star of 4 then a line, each follower on the leader's path), and writes to OUT_DIR:
   turning_formations.csv   one row per run and follower: max ||xi_i||, xi_max,i, min distance to
                            its target, perimeter alpha ||d_i||, max and mean distance from the
                            leader's path
@@ -13,7 +14,8 @@ chain of 10, with formation.slots world, turning, and turning with formation.tur
 The distance from the leader's path is that of each follower position (every tick) to the
 nearest point of the leader's path: its positions over the whole run (2 cm apart at 2 m/s and
 100 Hz), and the road it came on, 80 m straight behind its first position against its initial
-velocity, on which the followers start.
+velocity, on which the followers start (with path slots the convoy's virtual road, behind the
+leader along its slot direction).
 Usage: turning_table.py CF_SIM OUT_DIR
 """
 
@@ -35,9 +37,20 @@ SCENARIOS = (("figure eight", "figure_eight_2d.yaml", 60.0), ("circle", "turning
 FORMATIONS = (("pair", ["formation.followers=1"]),
               ("V star of 4", ["formation.followers=4", "formation.shape=v"]),
               ("chain of 10", ["formation.followers=10", "formation.topology=chain"]))
-FRAMES = ("world", "turning", "turning, reversing")
+FRAMES = ("world", "turning", "turning, reversing", "path")
 FRAME_SETS = {"world": ["formation.slots=world"], "turning": ["formation.slots=turning"],
-              "turning, reversing": ["formation.slots=turning", "formation.turning.reversing=true"]}
+              "turning, reversing": ["formation.slots=turning", "formation.turning.reversing=true"],
+              "path": ["formation.slots=path"]}
+# Path slots put every follower on its target's path: the star of 4 is a line (d_i = i d), each
+# follower an arc gap 1.5 ||d_i|| behind the leader.
+PATH_STAR = "star of 4 (line)"
+
+
+def formation_sets(formation, fsets, frame):
+    """The formation's name and overrides for FRAME (a V has no place on one path)."""
+    if frame == "path" and "formation.shape=v" in fsets:
+        return PATH_STAR, [s for s in fsets if s != "formation.shape=v"]
+    return formation, fsets
 
 
 def run(cf_sim, scenario, sets, csv_path):
@@ -61,11 +74,15 @@ def columns(path, prefix, k=2):
     return np.column_stack([data[f"{prefix}{i}"] for i in range(k)]), data
 
 
-def road_behind(start, data, length=80.0, spacing=0.02):
+def road_behind(start, data, frame, length=80.0, spacing=0.02):
     """The road the leader came on: LENGTH m straight behind its first position, against its
-    initial velocity (its followers start on it)."""
-    velocity = np.array([data["leader_v_0"][0], data["leader_v_1"][0]])
-    direction = velocity / np.linalg.norm(velocity)
+    initial velocity (its followers start on it); with path slots the convoy's virtual road (C1),
+    from follower 1's first position to the leader's."""
+    if frame == "path":
+        direction = start - np.array([data["follower_p_0"][0], data["follower_p_1"][0]])
+    else:
+        direction = np.array([data["leader_v_0"][0], data["leader_v_1"][0]])
+    direction = direction / np.linalg.norm(direction)
     s = np.arange(spacing, length, spacing)
     return start[None, :] - s[:, None] * direction[None, :]
 
@@ -78,7 +95,8 @@ def main():
         for name, scenario, duration in SCENARIOS:
             for formation, fsets in FORMATIONS:
                 for frame in FRAMES:
-                    sets = fsets + FRAME_SETS[frame]
+                    label, sets = formation_sets(formation, fsets, frame)
+                    sets = sets + FRAME_SETS[frame]
                     if duration:
                         sets.append(f"simulation.duration={duration}")
                     base = Path(tmp) / f"{scenario}_{formation}_{frame}.csv".replace(" ", "_").replace(",", "")
@@ -90,12 +108,12 @@ def main():
                         own, data = columns(f, "follower_p_")
                         if i == 1:
                             leader, data = columns(f, "leader_p_")
-                            tree = cKDTree(np.vstack([road_behind(leader[0], data), leader]))
+                            tree = cKDTree(np.vstack([road_behind(leader[0], data, frame), leader]))
                         stray, _ = tree.query(own)
                         s = followers[f"follower_{i}"]
                         xi_max = float(s["xi_max"])
                         rows.append({
-                            "scenario": name, "formation": formation, "slots": frame, "follower": i,
+                            "scenario": name, "formation": label, "slots": frame, "follower": i,
                             "target": s["target"], "max_xi": float(s["max_xi"]), "xi_max": xi_max,
                             "min_separation": float(s["min_separation"]),
                             "perimeter": xi_max / 4.0,  # alpha ||d_i|| = xi_max alpha / (1 - alpha), alpha 0.2
@@ -151,6 +169,8 @@ def plot(paths, path):
         for col, frame in enumerate(FRAMES):
             ax = axes[row][col]
             leader, followers = paths[(scenario, formation, frame)]
+            title = formation_sets(formation, ["formation.shape=v"] if "V" in formation else [],
+                                   frame)[0]
             ax.plot(leader[:, 0], leader[:, 1], "k-", lw=2.5, label="leader")
             for i, p in enumerate(followers, start=1):
                 ax.plot(p[:, 0], p[:, 1], lw=1, label=f"follower {i}" if len(followers) <= 4 else None)
@@ -162,7 +182,7 @@ def plot(paths, path):
                                 arrowprops={"arrowstyle": "->", "color": "k"})
                 ax.plot([leader[j, 0]] + [p[j, 0] for p in followers],
                         [leader[j, 1]] + [p[j, 1] for p in followers], "o", ms=3, color="grey")
-            ax.set_title(f"{scenario}, {formation}: {frame} slots")
+            ax.set_title(f"{scenario}, {title}: {frame} slots")
             ax.set_aspect("equal", adjustable="datalim")
             ax.grid(True, alpha=0.3)
             ax.set_xlabel("x (m)")

@@ -2,9 +2,11 @@
 
 #include <cstddef>
 #include <exception>
+#include <initializer_list>
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -13,6 +15,15 @@
 
 namespace projection_collision_avoidance::detail {
 namespace {
+
+/// Each number of @p keys that @p section has, into its place.
+void readNumbers(YamlReader& section, std::initializer_list<std::pair<const char*, double*>> keys) {
+  for (const auto& [key, value] : keys) {
+    if (section.has(key)) {
+      *value = section.number(key);
+    }
+  }
+}
 
 /// Sets the entry at path[index..] below @p node. Recurses once per path element of an
 /// override ("a.b.0.c"), so the depth is bounded by the length of a command-line key; the
@@ -134,19 +145,33 @@ FormationSpec readFormation(YamlReader& reader) {
   if (formation.has("turning")) {
     YamlReader turning = formation.map("turning");
     SlotHeadingParameters& heading = spec.turning;
-    for (const auto& [key, value] :
-         {std::pair{"natural_frequency", &heading.natural_frequency},
-          std::pair{"damping", &heading.damping}, std::pair{"max_yaw_rate", &heading.max_yaw_rate},
-          std::pair{"max_yaw_acceleration", &heading.max_yaw_acceleration},
-          std::pair{"min_speed", &heading.min_speed}}) {
-      if (turning.has(key)) {
-        *value = turning.number(key);
-      }
-    }
+    readNumbers(turning, {{"natural_frequency", &heading.natural_frequency},
+                          {"damping", &heading.damping},
+                          {"max_yaw_rate", &heading.max_yaw_rate},
+                          {"max_yaw_acceleration", &heading.max_yaw_acceleration},
+                          {"min_speed", &heading.min_speed}});
     if (turning.has("reversing")) {
       heading.reversing = turning.boolean("reversing");
     }
     turning.finish();
+  }
+  if (formation.has("path")) {
+    YamlReader path = formation.map("path");
+    ConvoyParameters& convoy = spec.path;
+    readNumbers(path, {{"gap_ratio", &convoy.gap_ratio},
+                       {"margin_ratio", &convoy.margin_ratio},
+                       {"spacing", &convoy.spacing},
+                       {"retrace_width", &convoy.retrace_width},
+                       {"natural_frequency", &convoy.natural_frequency},
+                       {"damping", &convoy.damping},
+                       {"max_acceleration", &convoy.max_acceleration},
+                       {"braking_acceleration", &convoy.braking_acceleration},
+                       {"target_braking", &convoy.target_braking},
+                       {"catch_up_speed", &convoy.catch_up_speed}});
+    if (path.has("capacity")) {
+      convoy.capacity = path.integer("capacity");
+    }
+    path.finish();
   }
   formation.finish();
   return spec;

@@ -49,6 +49,35 @@ void FormationSpec::validate(const AgentModel& model) const {
     }
     turning.validate("formation.turning");
   }
+  if (slots == SlotFrame::kPath) {
+    const int axes = model.double_integrator_axes;
+    if (axes < 1 || axes > 3) {
+      throw ParameterError("formation.slots",
+                           "path needs a double_integrator model of 1 to 3 axes; use world");
+    }
+    if (shape != FormationShape::kLine) {
+      throw ParameterError("formation.slots",
+                           "path puts every follower on its target's path: use shape line");
+    }
+    path.validate("formation.path");
+  }
+}
+
+void FormationSpec::validateConvoy(const ControllerParameters& controller) const {
+  if (slots != SlotFrame::kPath) {
+    return;
+  }
+  if (controller.leader_input_in_command || controller.leader_input_in_estimator) {
+    throw ParameterError(controller.leader_input_in_command
+                             ? "controller.leader_information.command"
+                             : "controller.leader_information.estimator",
+                         "must be false with formation.slots: path (a convoy follower tracks its "
+                         "own reference point, not its target's acceleration)");
+  }
+  if (controller.time_headway > 0.0) {
+    throw ParameterError("controller.spacing.time_headway",
+                         "must be 0 with formation.slots: path (the arc gap sets the spacing)");
+  }
 }
 
 FormationMember formationSlot(const FormationSpec& spec, const Eigen::VectorXd& separation,
@@ -94,6 +123,18 @@ std::vector<FormationMember> layoutFormation(const FormationSpec& spec,
       turningSlotOffset(member.separation, axes, SlotHeadingSample{member.initial_heading, 0, 0},
                         &slot);
     }
+    if (spec.slots == SlotFrame::kPath) {
+      const int axes = static_cast<int>(target_state.size() / 2);
+      member.path_direction.head(axes) = member.separation.head(axes).normalized();
+      ConvoyReference reference(spec.path, 1.0, member.separation.head(axes).norm());
+      Eigen::Vector3d position = Eigen::Vector3d::Zero();
+      Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+      position.head(axes) = target_state.head(axes);
+      velocity.head(axes) = target_state.segment(axes, axes);
+      reference.reset(position, velocity, member.path_direction);
+      const ConvoySample start = reference.tick(position, velocity);
+      convoySlotOffset(target_state, axes, start, &slot);
+    }
     member.initial_state = target_state - slot - initial_error;
     members.push_back(member);
   }
@@ -121,7 +162,9 @@ std::string toString(FormationTopology topology) {
 
 std::string toString(FormationShape shape) { return shape == FormationShape::kV ? "v" : "line"; }
 
-std::string toString(SlotFrame frame) { return frame == SlotFrame::kTurning ? "turning" : "world"; }
+std::string toString(SlotFrame frame) {
+  return frame == SlotFrame::kTurning ? "turning" : frame == SlotFrame::kPath ? "path" : "world";
+}
 
 FormationTopology parseFormationTopology(const std::string& text, const std::string& key) {
   if (text == "star") {
@@ -150,7 +193,10 @@ SlotFrame parseSlotFrame(const std::string& text, const std::string& key) {
   if (text == "turning") {
     return SlotFrame::kTurning;
   }
-  throw ParameterError(key, "must be world or turning, got '" + text + "'");
+  if (text == "path") {
+    return SlotFrame::kPath;
+  }
+  throw ParameterError(key, "must be world, turning or path, got '" + text + "'");
 }
 
 }  // namespace projection_collision_avoidance

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "projection_collision_avoidance/core/ControllerDesign.hpp"
+#include "projection_collision_avoidance/core/ConvoyReference.hpp"
 #include "projection_collision_avoidance/core/DimensionDispatch.hpp"
 #include "projection_collision_avoidance/core/FollowerController.hpp"
 #include "projection_collision_avoidance/core/PaperLaws.hpp"
@@ -43,8 +44,11 @@ double positionDistance(const Vector& a, const Vector& b, int k) {
 template <typename Dims>
 struct SimulatedFollower {
   /// @param turning the slot heading's generator of turning slots; null for world slots
+  /// @param path the convoy's parameters of path slots and @p target_state its target's initial
+  /// state; null for other slots
   SimulatedFollower(const FormationMember& formation_member, const ControllerDesign& member_design,
-                    const AgentModel& model, const SlotHeadingParameters* turning)
+                    const AgentModel& model, const SlotHeadingParameters* turning,
+                    const ConvoyParameters* path, const Eigen::VectorXd& target_state)
       : member(formation_member),
         design(member_design),
         controller(member_design),
@@ -54,6 +58,15 @@ struct SimulatedFollower {
     if (turning) {
       heading.emplace(*turning, member_design.period);
       heading->reset(formation_member.initial_heading);
+    }
+    if (path) {
+      const int k = model.position_dimension;
+      convoy.emplace(*path, member_design.period, separation.head(k).norm());
+      Eigen::Vector3d position = Eigen::Vector3d::Zero();
+      Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+      position.head(k) = target_state.head(k);
+      velocity.head(k) = target_state.segment(k, k);
+      convoy->reset(position, velocity, formation_member.path_direction);
     }
     summary.xi_max = design.xi_max;
     summary.perimeter = design.perimeter;
@@ -67,6 +80,7 @@ struct SimulatedFollower {
   typename Dims::StateVector separation;  // d_i
   typename Dims::InputVector command;     // u_i at the current tick
   std::optional<SlotHeading> heading;     // theta_i (T1) of a turning slot
+  std::optional<ConvoyReference> convoy;  // r_i (C1)-(C3) of a path slot
   SimulationSummary summary;
 };
 
@@ -85,6 +99,7 @@ FormationSummary runFormation(const Scenario& scenario, const ControllerDesign& 
   const typename Dims::OutputMatrix output_matrix = model.C;
 
   const bool turning = scenario.formation.slots == SlotFrame::kTurning;
+  const bool path = scenario.formation.slots == SlotFrame::kPath;
   const std::vector<FormationMember> members =
       layoutFormation(scenario.formation, p.separation, scenario.leader_initial_state,
                       scenario.follower_initial_state);
@@ -92,8 +107,12 @@ FormationSummary runFormation(const Scenario& scenario, const ControllerDesign& 
   std::vector<SimulatedFollower<Dims>> followers;
   followers.reserve(members.size());
   for (const FormationMember& member : members) {
+    const Eigen::VectorXd& target_initial_state =
+        member.target == 0 ? scenario.leader_initial_state
+                           : members[static_cast<std::size_t>(member.target - 1)].initial_state;
     followers.emplace_back(member, ControllerDesign::create(memberParameters(p, member)), model,
-                           turning ? &scenario.formation.turning : nullptr);
+                           turning ? &scenario.formation.turning : nullptr,
+                           path ? &scenario.formation.path : nullptr, target_initial_state);
   }
   AgentIntegrator<Dims> leader(model, scenario_design.period, scenario.leader_initial_state,
                                scenario.disturbance);
@@ -142,6 +161,16 @@ FormationSummary runFormation(const Scenario& scenario, const ControllerDesign& 
         turningSlotOffset(follower.separation, k, heading, &slot);
         turningSlotAcceleration(follower.separation, k, heading, &slot_acceleration);
       }
+      ConvoySample convoy;
+      if (follower.convoy) {
+        Eigen::Vector3d position = Eigen::Vector3d::Zero();
+        Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+        position.head(k) = target_state.head(k);
+        velocity.head(k) = target_state.segment(k, k);
+        convoy = follower.convoy->tick(position, velocity);
+        convoySlotOffset(target_state, k, convoy, &slot);       // D_i (C4)
+        convoySlotAcceleration(convoy, k, &slot_acceleration);  // u_r (C4)
+      }
       const StateVector xi = target_state - follower.plant.state() - slot;
       const OutputVector y = output_matrix * xi;
       const StateVector& own_state = follower.plant.state();
@@ -149,7 +178,7 @@ FormationSummary runFormation(const Scenario& scenario, const ControllerDesign& 
       if (share_leader_input) {
         inputs.leader_input = target_acceleration;
       }
-      if (follower.heading) {
+      if (follower.heading || follower.convoy) {
         inputs.slot_acceleration = slot_acceleration;
       }
       const auto& status = follower.controller.step(inputs);
@@ -180,6 +209,7 @@ FormationSummary runFormation(const Scenario& scenario, const ControllerDesign& 
         sample.distance = separation;
         sample.slot_heading = heading;
         sample.slot = slot;
+        sample.convoy = convoy;
         sample.controller = status;
         sample.leader_input = behind_leader ? leader_input : ahead->command;
         sample.disturbance = behind_leader ? disturbance : zero_disturbance;

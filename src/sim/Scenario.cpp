@@ -27,6 +27,7 @@ void Scenario::validate() const {
     throw ParameterError("simulation.duration", "must be positive (s)");
   }
   formation.validate(model);
+  formation.validateConvoy(controller);
   if (link.configured) {
     link.validate(controller.control_rate);
     // A sender keeps D + 1 values in flight (SharedLink): bound the memory of the whole formation.

@@ -29,6 +29,7 @@ SimulationCsvWriter::SimulationCsvWriter(std::ostream& out, const Scenario& scen
       positions_(scenario.controller.model.position_dimension),
       velocities_(scenario.controller.model.isDoubleIntegrator()),
       turning_(scenario.formation.slots == SlotFrame::kTurning),
+      path_(scenario.formation.slots == SlotFrame::kPath),
       xi_max_(hardBound(scenario.controller.alpha, scenario.controller.separation.norm())),
       xi_soft_(softBound(xi_max_, scenario.controller.epsilon)),  // xi_max_ is set above
       perimeter_(
@@ -54,6 +55,13 @@ SimulationCsvWriter::SimulationCsvWriter(std::ostream& out, const Scenario& scen
     out_ << ",slot_heading,slot_yaw_rate,slot_yaw_acceleration";
     writeHeaderColumns(out_, "slot_p_", positions_);
     writeHeaderColumns(out_, "u_slot_", inputs_);
+  }
+  if (path_) {
+    writeHeaderColumns(out_, "slot_p_", positions_);
+    writeHeaderColumns(out_, "u_slot_", inputs_);
+    writeHeaderColumns(out_, "ref_p_", positions_);
+    writeHeaderColumns(out_, "goal_p_", positions_);
+    out_ << ",progress,goal_arc,chord,braking";
   }
   out_ << '\n';
 }
@@ -82,6 +90,14 @@ void SimulationCsvWriter::write(const SimulationSample& s) {
          << s.slot_heading.acceleration;
     writeValues(out_, s.slot, positions_);
     writeValues(out_, s.controller.slot_command, inputs_);
+  }
+  if (path_) {
+    writeValues(out_, s.slot, positions_);
+    writeValues(out_, s.controller.slot_command, inputs_);
+    writeValues(out_, s.convoy.position, positions_);
+    writeValues(out_, s.convoy.goal, positions_);
+    out_ << ',' << s.convoy.progress << ',' << s.convoy.goal_arc << ',' << s.convoy.chord << ','
+         << (s.convoy.braking ? 1 : 0);
   }
   out_ << '\n';
 }

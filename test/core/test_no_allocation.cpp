@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "projection_collision_avoidance/core/ControllerDesign.hpp"
+#include "projection_collision_avoidance/core/ConvoyReference.hpp"
 #include "projection_collision_avoidance/core/DynamicFollowerController.hpp"
 #include "projection_collision_avoidance/core/FollowerController.hpp"
 #include "projection_collision_avoidance/sim/AgentIntegrator.hpp"
@@ -224,6 +225,46 @@ TEST(NoAllocation, VehicleModelSteps) {
   EXPECT_EQ(testing::allocationCount() - before, 0);
   EXPECT_TRUE(velocity.position().allFinite());
   EXPECT_TRUE(std::isfinite(unicycle.state().x));
+}
+
+/// A convoy follower's reference (ConvoyReference::tick(), and so TargetPath::record, at and
+/// walkBack) allocates nothing after construction: rings that wrap (300 m driven), turns
+/// tight enough for the goal to walk back onto the virtual road, reversals over the path, jumps
+/// and a lost (NaN) target.
+TEST(NoAllocation, ConvoyReferenceTicks) {
+  for (const int capacity : {16, 4096}) {
+    ConvoyParameters parameters;
+    parameters.capacity = capacity;
+    ConvoyReference reference(parameters, 0.01, 1.0);
+    reference.reset(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitX());
+    Eigen::Vector3d position = Eigen::Vector3d::Zero();
+    double sink = 0.0;
+    const long before = testing::allocationCount();
+    for (int k = 0; k < 20000; ++k) {
+      const double t = 0.01 * k;
+      const int phase = (k / 1000) % 5;
+      Eigen::Vector3d velocity(1.5, 0.0, 0.0);
+      if (phase == 1) {  // a tight circle (radius 0.3 m)
+        velocity = 1.5 * Eigen::Vector3d(std::cos(5.0 * t), std::sin(5.0 * t), 0.0);
+      } else if (phase == 2) {  // back over the path
+        velocity = -velocity;
+      }
+      position += 0.01 * velocity;
+      if (k % 997 == 0) {
+        position += Eigen::Vector3d(0.5, -2.0, 0.1);  // a jump
+      }
+      Eigen::Vector3d measured = position;
+      if (phase == 3 && k % 1000 < 20) {
+        measured.x() = std::numeric_limits<double>::quiet_NaN();
+      }
+      const ConvoySample sample = reference.tick(measured, velocity);
+      sink += sample.position.sum() + sample.goal_arc +
+              reference.path().walkBack(sample.progress, measured, 2.0);
+    }
+    EXPECT_EQ(testing::allocationCount() - before, 0) << capacity;
+    EXPECT_TRUE(std::isfinite(sink));
+    EXPECT_EQ(reference.path().size(), capacity);  // the ring full: it wrapped
+  }
 }
 
 /// The command adapter's conversion (velocity commands brought up to date with the command

@@ -7,6 +7,7 @@
 
 #include "projection_collision_avoidance/core/AgentModel.hpp"
 #include "projection_collision_avoidance/core/ControllerParameters.hpp"
+#include "projection_collision_avoidance/core/ConvoyReference.hpp"
 #include "projection_collision_avoidance/core/TurningSlot.hpp"
 
 namespace projection_collision_avoidance {
@@ -27,6 +28,7 @@ enum class FormationShape {
 enum class SlotFrame {
   kWorld,    ///< fixed in the world, as the paper's d: the formation translates, never turns
   kTurning,  ///< in the target's body frame, turned with the slot heading theta (T1)-(T3)
+  kPath,     ///< a convoy: on the target's path, an arc gap behind it (C1)-(C4)
 };
 
 /// The followers of a scenario (section `formation` of a scenario file). Without that section a
@@ -39,14 +41,20 @@ struct FormationSpec {
   double half_angle = 0.5235987755982988;  ///< rad, angle of each arm of a V to d (30 deg)
   SlotFrame slots = SlotFrame::kWorld;     ///< formation.slots
   SlotHeadingParameters turning;           ///< formation.turning (slots: turning)
+  ConvoyParameters path;                   ///< formation.path (slots: path)
 
   static constexpr int kMaxFollowers = 1000;
 
   /// Throws ParameterError naming formation.followers / .shape / .half_angle for a count out of
   /// range, a V on a model that is not a double integrator of 2 or 3 axes, or an angle outside
-  /// (0, pi/2); formation.slots for turning slots on such a model; formation.turning.* for a
-  /// bad generator (SlotHeadingParameters::validate()).
+  /// (0, pi/2); formation.slots for turning slots on such a model, or path slots on a model
+  /// that is not a double integrator or in a V; formation.turning.* for a bad generator
+  /// (SlotHeadingParameters::validate()); formation.path.* (ConvoyParameters::validate()).
   void validate(const AgentModel& model) const;
+  /// With path slots: throws ParameterError naming the keys of the controller's shared leader
+  /// input and time headway when they are on (a convoy follower tracks its own reference point:
+  /// doc/math.md, (C4)).
+  void validateConvoy(const ControllerParameters& controller) const;
 };
 
 /// One follower of a formation, with everything that differs from one follower to the next.
@@ -61,6 +69,9 @@ struct FormationMember {
   /// theta(0) of a turning slot (rad): the heading of the target's initial velocity
   /// (velocityHeading()), 0 when it has none; 0 for world slots.
   double initial_heading = 0.0;
+  /// Path slots: the unit direction of d_i's position part (3 entries), the target's path's
+  /// initial direction (C1); zero otherwise.
+  Eigen::Vector3d path_direction = Eigen::Vector3d::Zero();
   /// x_i(0) = x_target(0) - D_i - xi_0 (D_i = d_i, or turned by theta(0) (T2)), with xi_0 = x_1(0)
   /// - x_2(0) - d the scenario's initial relative error, so that every follower starts as the
   /// scenario's single follower does.
@@ -74,7 +85,8 @@ FormationMember formationSlot(const FormationSpec& spec, const Eigen::VectorXd& 
 
 /// The followers of a formation in index order (every target precedes its follower).
 ///
-/// With turning slots, follower i starts on its slot turned by theta_i(0) (initial_heading).
+/// With turning slots, follower i starts on its slot turned by theta_i(0) (initial_heading);
+/// with path slots, on its reference point's initial state (ConvoyReference::reset()).
 /// With d the scenario's separation, r_i = ceil(i / 2) and R(+-theta) the rotation of the
 /// position part about the z axis (the x-y plane) by the V's half angle theta, sign + for odd i:
 ///   star, line:   d_i = i d,                target 0
@@ -94,7 +106,7 @@ std::vector<FormationMember> layoutFormation(const FormationSpec& spec,
 ControllerParameters memberParameters(const ControllerParameters& parameters,
                                       const FormationMember& member);
 
-/// "star", "chain"; "line", "v"; "world", "turning".
+/// "star", "chain"; "line", "v"; "world", "turning", "path".
 std::string toString(FormationTopology topology);
 std::string toString(FormationShape shape);
 std::string toString(SlotFrame frame);
@@ -102,7 +114,7 @@ std::string toString(SlotFrame frame);
 /// Parses "star" / "chain" and "line" / "v"; throws ParameterError(key) otherwise.
 FormationTopology parseFormationTopology(const std::string& text, const std::string& key);
 FormationShape parseFormationShape(const std::string& text, const std::string& key);
-/// Parses "world" / "turning"; throws ParameterError(key) otherwise.
+/// Parses "world" / "turning" / "path"; throws ParameterError(key) otherwise.
 SlotFrame parseSlotFrame(const std::string& text, const std::string& key);
 
 }  // namespace projection_collision_avoidance

@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 
+#include "projection_collision_avoidance/core/ConvoyReference.hpp"
 #include "projection_collision_avoidance/core/FollowerControllerStatus.hpp"
 #include "projection_collision_avoidance/core/TurningSlot.hpp"
 #include "projection_collision_avoidance/sim/Scenario.hpp"
@@ -23,7 +24,9 @@ struct SimulationSample {
   /// The slot heading theta, theta' and theta'' of a turning slot (T1) (rad, rad/s, rad/s^2);
   /// 0 for a world slot.
   SlotHeadingSample slot_heading;
-  Eigen::VectorXd slot;          ///< D = x_1 - x_2 on the slot (T2): d, or d turned by theta
+  Eigen::VectorXd slot;  ///< D = x_1 - x_2 on the slot: d, d turned by theta (T2), or (C4)
+  /// A path slot's reference r, its goal q and the chord (C1)-(C4); zero for other slots.
+  ConvoySample convoy;
   Eigen::VectorXd leader_input;  ///< the target's acceleration input (u_1(t_k) for the leader)
   Eigen::VectorXd disturbance;   ///< the target's disturbance (u_d(t_k) for the leader, else 0)
   /// The controller's status at t_k, the one type the nodes publish (estimate, f, projection,
@@ -62,7 +65,9 @@ using FormationObserver = std::function<void(int member, const SimulationSample&
 /// steps on y_i = C (x_target - x_i - d_i); then every agent is integrated exactly to t_{k+1},
 /// inputs held, the leader's step split at disturbance pulse edges. With turning slots
 /// (formation.slots: turning) follower i's slot is D_i (T2), turned by its slot heading (T1),
-/// which follows the heading of its target's velocity, and it is given u_r (T3). Each follower is
+/// which follows the heading of its target's velocity, and it is given u_r (T3); with path slots
+/// (formation.slots: path) it tracks its reference point on its target's path (C1)-(C3), D_i and
+/// u_r of (C4), with no shared acceleration of its target. Each follower is
 /// given its own state x_i for the time headway (S1). With leader information
 /// (controller.leader_information) a follower of the leader is given a_1 = u_1(t_k) (+ pinv(B)
 /// u_d(t_k) when the disturbance is shared), and a follower of follower j the command follower j
