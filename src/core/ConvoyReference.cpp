@@ -66,6 +66,7 @@ void ConvoyReference::reset(const Eigen::Vector3d& target_position,
   position_ = path_.at(sigma);
   previous_progress_ = path_.progress();
   previous_goal_arc_ = sigma;
+  previous_goal_ = position_;
   const Eigen::Vector3d along = path_.at(1.0) - path_.at(0.0);  // the unit initial direction
   velocity_ = target_velocity.allFinite() ? Eigen::Vector3d(along * along.dot(target_velocity))
                                           : Eigen::Vector3d::Zero();
@@ -130,25 +131,32 @@ Eigen::Vector3d ConvoyReference::acceleration(const Eigen::Vector3d& goal,
 
 ConvoySample ConvoyReference::tick(const Eigen::Vector3d& target_position,
                                    const Eigen::Vector3d& target_velocity) {
-  path_.record(target_position);
-  ConvoySample sample;
-  sample.progress = path_.progress();
-  double upper = sample.progress - gap_;  // (C2)
-  if (have_goal_) {
-    upper =
-        std::min(upper, previous_goal_arc_ + std::max(0.0, sample.progress - previous_progress_) +
-                            parameters_.catch_up_speed * period_);
-  }
-  sample.goal_arc = path_.walkBack(upper, target_position, goal_chord_);
-  sample.goal = path_.at(sample.goal_arc);
-  const Eigen::Vector3d goal_velocity =
-      have_goal_ ? Eigen::Vector3d((sample.goal - previous_goal_) / period_)
-                 : Eigen::Vector3d(velocity_);
-  previous_progress_ = sample.progress;
-  previous_goal_arc_ = sample.goal_arc;
-  previous_goal_ = sample.goal;
-  have_goal_ = true;
+  // A target position not known this tick (not finite) records nothing and the goal keeps its
+  // arc and point (q' = 0): the reference comes to rest at the last goal. Without a finite
+  // velocity too, the target is unknown to (C3)'s speed bound and to (C5).
   const bool known = target_position.allFinite() && target_velocity.allFinite();
+  ConvoySample sample;
+  Eigen::Vector3d goal_velocity = Eigen::Vector3d::Zero();
+  if (target_position.allFinite()) {
+    path_.record(target_position);
+    double upper = path_.progress() - gap_;  // (C2)
+    if (have_goal_) {
+      upper = std::min(upper, previous_goal_arc_ +
+                                  std::max(0.0, path_.progress() - previous_progress_) +
+                                  parameters_.catch_up_speed * period_);
+    }
+    const double arc = path_.walkBack(upper, target_position, goal_chord_);
+    const Eigen::Vector3d goal = path_.at(arc);
+    goal_velocity = have_goal_ ? Eigen::Vector3d((goal - previous_goal_) / period_)
+                               : Eigen::Vector3d(velocity_);
+    previous_progress_ = path_.progress();
+    previous_goal_arc_ = arc;
+    previous_goal_ = goal;
+    have_goal_ = true;
+  }
+  sample.progress = path_.progress();
+  sample.goal_arc = previous_goal_arc_;
+  sample.goal = previous_goal_;
   sample.position = position_;
   sample.velocity = velocity_;
   sample.acceleration = acceleration(sample.goal, goal_velocity, target_position, target_velocity,

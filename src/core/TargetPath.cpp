@@ -26,6 +26,7 @@ void TargetPath::reset(const Eigen::Vector3d& start, const Eigen::Vector3d& dire
   tip_ = start.allFinite() ? start : Eigen::Vector3d::Zero();
   push(tip_, 0.0);
   progress_ = 0.0;
+  retracing_ = false;
 }
 
 const Eigen::Vector3d& TargetPath::point(int i) const {
@@ -58,37 +59,55 @@ Eigen::Vector3d TargetPath::oldestDirection() const {
   return direction_;
 }
 
+void TargetPath::latestLine(Eigen::Vector3d* end, Eigen::Vector3d* along) const {
+  *end = point(count_ - 1);
+  if (count_ >= 2) {
+    const Eigen::Vector3d segment = *end - point(count_ - 2);
+    const double length = segment.norm();
+    if (length > 0.0) {
+      *along = segment / length;
+      return;
+    }
+  }
+  *along = direction_;
+}
+
 void TargetPath::record(const Eigen::Vector3d& target) {
   if (!target.allFinite()) {
     return;
   }
   tip_ = target;
-  // Driving back over the path: off with the points driven back over.
-  while (count_ >= 2) {
-    const Eigen::Vector3d& a = point(count_ - 2);
-    const Eigen::Vector3d& b = point(count_ - 1);
-    const Eigen::Vector3d segment = b - a;
-    const double length = segment.norm();
-    const Eigen::Vector3d along = segment / length;
-    const double behind = (target - b).dot(along);
-    const double across = ((target - b) - behind * along).norm();
-    if (!(behind < 0.0 && across <= retrace_width_)) {
+  // Driving back over the path: off with the points driven back over; behind the only point,
+  // on the virtual road, the point itself slides back to the target's foot.
+  Eigen::Vector3d end;
+  Eigen::Vector3d along;
+  double ahead = 0.0;
+  double across = 0.0;
+  for (;;) {
+    latestLine(&end, &along);
+    ahead = (target - end).dot(along);
+    across = ((target - end) - ahead * along).norm();
+    if (!(ahead < 0.0 && across <= retrace_width_)) {
       break;
     }
-    --count_;
-  }
-  if (count_ == 1) {  // behind the only point, on the virtual road: the point slides back
-    const Eigen::Vector3d along = direction_;
-    const double behind = (target - point(0)).dot(along);
-    const double across = ((target - point(0)) - behind * along).norm();
-    if (behind < 0.0 && across <= retrace_width_) {
-      auto& first = points_[static_cast<std::size_t>(first_)];
-      first += behind * along;
-      arcs_[static_cast<std::size_t>(first_)] += behind;
+    retracing_ = true;
+    if (count_ >= 2) {
+      --count_;
+      continue;
     }
+    points_[static_cast<std::size_t>(first_)] += ahead * along;
+    arcs_[static_cast<std::size_t>(first_)] += ahead;
+    ahead = 0.0;
+    break;
   }
-  const Eigen::Vector3d& last = point(count_ - 1);
-  const double beyond = (target - last).norm();
+  // While retracing, a target beside the latest segment's line (within retrace_width, less than
+  // spacing ahead) adds no point: a reversing target that drifts sideways stays on its path.
+  if (retracing_ && ahead < spacing_ && across <= retrace_width_) {
+    progress_ = arc(count_ - 1) + (target - point(count_ - 1)).norm();
+    return;
+  }
+  retracing_ = false;
+  const double beyond = (target - point(count_ - 1)).norm();
   if (beyond >= spacing_) {
     push(target, arc(count_ - 1) + beyond);
     progress_ = arc(count_ - 1);

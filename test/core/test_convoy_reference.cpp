@@ -284,14 +284,9 @@ TEST(ConvoyReference, BoundsHoldForAnyTargetMotion) {
 }
 
 /// The target's position lost (NaN) for 0.2 s while it drives straight at 0.5 m/s: the samples
-/// stay finite (checked by run()) and r keeps going: the goal holds its arc, r' stays forward.
-///
-/// KNOWN FAILURE (a bug in ConvoyReference::tick / TargetPath::walkBack, reported; the C++ left as
-/// it is): with a NaN target walkBack's distance tests are all false and its virtual-road root is
-/// NaN, so it returns the oldest point's arc: the goal jumps back to the oldest recorded point
-/// (here 3.5 m; after 300 m at 1 m/s with the default ring, 232 m, and 10 s later it is still
-/// 134 m behind the target's progress), r brakes and reverses, and the goal then crawls forward
-/// at catch_up_speed.
+/// stay finite (checked by run()), the goal holds its arc instead of jumping back along the path,
+/// r slows toward the held goal without stopping or reversing, and once the target is back r
+/// converges to the gap behind it again.
 TEST(ConvoyReference, LostTargetPositionDoesNotThrowTheGoalBack) {
   const ConvoyParameters p;
   auto clean = straight(Vector3::Zero(), Vector3::UnitX(), 0.5);
@@ -302,7 +297,7 @@ TEST(ConvoyReference, LostTargetPositionDoesNotThrowTheGoalBack) {
     }
     return t;
   };
-  const std::vector<ConvoySample> samples = run(p, 1.0, 1200, noisy);
+  const std::vector<ConvoySample> samples = run(p, 1.0, 2000, noisy);
   double lowest_speed = 1e9;
   double largest_step_back = 0.0;
   for (int k = 995; k < 1100; ++k) {
@@ -311,7 +306,7 @@ TEST(ConvoyReference, LostTargetPositionDoesNotThrowTheGoalBack) {
   }
   EXPECT_LE(largest_step_back, 1e-9) << "the goal jumped back along the path";
   EXPECT_GT(lowest_speed, 0.0) << "r stopped or reversed";
-  EXPECT_LT((samples.back().position - (clean(1199).position - 1.5 * Vector3::UnitX())).norm(),
+  EXPECT_LT((samples.back().position - (clean(1999).position - 1.5 * Vector3::UnitX())).norm(),
             1e-3);
 }
 

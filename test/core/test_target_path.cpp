@@ -276,14 +276,8 @@ TEST(TargetPath, RetracingLowersTheProgress) {
 /// 0.05 m and retrace_width 0.5 m, 1 m/s at 100 Hz): (C1) says it takes the points it drove back
 /// over off again, so s goes down while it reverses; s stays within the drift of the position
 /// along the line.
-///
-/// KNOWN FAILURE (a bug in TargetPath::record, reported, the C++ left as it is): once the drift
-/// exceeds about the spacing the target is >= spacing from the latest kept point, a point is
-/// recorded beside the path, and the latest segment (from the path to that point) points sideways:
-/// the reversing target is then no longer "behind" it, so the points are no longer taken off and
-/// s grows by the distance driven instead. With a drift to 0.1 m (a fifth of retrace_width) over
-/// 2 m of reversing from s = 5, s ends at 4.97 instead of ~3; the effective retrace width is the
-/// spacing, not retrace_width. Drifts of 0.03 m pass.
+/// A point beside the path is not recorded while the target retraces, so the latest segment
+/// stays on the path and the target stays "behind" it.
 TEST(TargetPath, ReversingWithASidewaysDriftWithinRetraceWidthLowersTheProgress) {
   for (const double width : {0.03, 0.1, 0.3}) {
     TargetPath path(4096, 0.05, 0.5);

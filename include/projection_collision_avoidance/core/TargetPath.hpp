@@ -16,7 +16,9 @@ namespace projection_collision_avoidance {
 ///    point; when the ring is full the oldest point goes;
 ///  - a target that drives back over its own path (behind the latest point along the latest
 ///    segment, within @p retrace_width of that segment's line) takes the points it drove back
-///    over off the path, so that its progress s goes down as it reverses;
+///    over off the path, so that its progress s goes down as it reverses; while it does, a
+///    position beside the latest segment (within @p retrace_width, less than @p spacing ahead)
+///    adds no point, so a reversing target that drifts sideways stays on its path;
 ///  - the path goes on from the latest point straight to the target, s = sigma_last + ||p_t −
 ///    P_last||, and before the oldest point it goes on straight backward (along the oldest
 ///    segment, or the initial direction while there is one point): a virtual road behind it.
@@ -52,6 +54,9 @@ class TargetPath {
   const Eigen::Vector3d& point(int i) const;  // i = 0 (oldest) .. count_ - 1
   double arc(int i) const;
   void push(const Eigen::Vector3d& position, double sigma);
+  /// The latest point @p end and the unit direction of the latest segment @p along (the initial
+  /// direction while there is one point).
+  void latestLine(Eigen::Vector3d* end, Eigen::Vector3d* along) const;
   /// The unit direction of the path at its oldest point (forward).
   Eigen::Vector3d oldestDirection() const;
   /// The largest t in [0, length] of a + t u with ||a + t u − target|| >= chord at or below
@@ -69,6 +74,7 @@ class TargetPath {
   Eigen::Vector3d direction_ = Eigen::Vector3d::UnitX();  ///< initial forward direction
   Eigen::Vector3d tip_ = Eigen::Vector3d::Zero();         ///< the target's latest position
   double progress_ = 0.0;
+  bool retracing_ = false;  ///< points were taken off since the latest one was added
 };
 
 }  // namespace projection_collision_avoidance
