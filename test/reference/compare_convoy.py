@@ -29,27 +29,12 @@ tick and by metres within seconds). A threshold of (C1) decided differently thro
 point added at exactly `spacing`, a retrace at exactly 0) would show as an isolated larger
 difference; none was seen.
 
-Measured (2026-12-05, cf_sim built 16:35 from the working tree, src/core/ConvoyReference.cpp
-modified and not committed; runtime 12 s with --jobs 2 on 2 cores). q and s, which depend on the
-target only, agree over whole runs within 1.6e-10 m (pair_figure_eight, 12,001 ticks; <= 5e-11 m
-elsewhere), and r and p within 3e-11 m up to the first tick where cf_sim's r'' leaves (C3)/(C5)
-computed from its own state; from there every case FAILS by metres:
-
-    case                    first r'' departure (t, s)   max |r diff|, whole run (m)
-    pair_circle             0.03                         17
-    pair_u_turn             20.59                        6.6
-    pair_stop_and_go        19.88                        7.7
-    pair_figure_eight       0.02                         3.0
-    chain3_u_turn           20.59 / 16.75 / 16.76        6.6 / 8.9 / 11
-    chain3_stop_and_go      19.88 / 19.89 / 19.91        7.7 / 17 / 18
-    laws_stop_and_go        20.67                        4.9
-    fast_u_turn_short_ring  11.16                        17
-    line_1d_reversing       20.01                        2.0
-    figure_eight_3d         0.02                         3.0
-
-(followers 2 and 3 of a chain depart at their own ticks, before their target does). An earlier
-build of the same day (before 16:30) gave pair_u_turn's min_separation as 6.52925636, the
-reference's to all nine digits.
+Measured (2026-12-06, runtime 10 s with --jobs 2 on 2 cores): every case passes; the largest
+difference over all ticks and followers is 1.6e-10 m in r and p (pair_figure_eight, 12,001
+ticks; <= 6e-11 m elsewhere), min_separation agrees to all printed digits and the smallest chord
+within 3e-12 m. Before (C3) took its speed form and (C5) its divisor delta, the same comparison
+against the earlier laws failed every case by metres from the first tick where r'' differed: a
+change of law does not hide under the tolerance.
 
 One line per case, then ``N passed, M failed``; exit status 1 if any failed, 2 for a bad command
 line. --xunit writes a JUnit XML file as compare_with_reference.py does. A tool path ending in

@@ -15,8 +15,9 @@ convoy_reference.py. The follower records its target's position p_t at each tick
      - Retrace: while p_t is behind the latest point along the latest segment and within
        `retrace_width` of that segment's line, the latest point is taken off, so s goes down
        while the target reverses. With one point left, behind it along the road, the point
-       itself moves back along the road to the foot of p_t (doc/math.md does not say what
-       happens there; this is the reading cf_sim agrees with).
+       itself moves back along the road to the foot of p_t. While retracing, a p_t less than
+       `spacing` ahead of the latest point along the latest segment and within
+       `retrace_width` of its line adds no point; retracing ends once a point is added.
 
 (C2) sigma*_k = walkBack(min(s_k - g, sigma*_{k-1} + max(0, s_k - s_{k-1}) + c T), p_t, c_q),
      q_k = P(sigma*_k), where walkBack(sigma, p, c) is the largest sigma' <= sigma with
@@ -47,6 +48,7 @@ class TargetPath:
         self.start_direction = direction        # the road's direction with one point
         self.target = np.array(p0, dtype=float)
         self.s = 0.0
+        self.retracing = False
 
     def _direction(self, i):
         """Unit direction of the segment from point i to point i + 1."""
@@ -71,18 +73,23 @@ class TargetPath:
             u = self.latest_direction()
             rel = p - self.pts[last]
             along = float(rel @ u)
-            if not along < 0.0:
-                break
             lateral = rel - along * u
-            if math.sqrt(float(lateral @ lateral)) > self.retrace_width:
+            beside = math.sqrt(float(lateral @ lateral)) <= self.retrace_width
+            if not (along < 0.0 and beside):
                 break
+            self.retracing = True
             if self.hi - self.lo >= 2:
                 self.hi -= 1                        # drove back over the latest point
                 continue
             self.pts[last] = self.pts[last] + along * u   # back along the road: to p's foot
             self.arc[last] += along
+            along = 0.0
             break
         gap = math.sqrt(float((p - self.pts[self.hi - 1]) @ (p - self.pts[self.hi - 1])))
+        if self.retracing and along < self.spacing and beside:
+            self.s = self.arc[self.hi - 1] + gap    # beside the path while retracing: no point
+            return self.s
+        self.retracing = False
         if gap >= self.spacing:
             self.pts[self.hi] = p
             self.arc[self.hi] = self.arc[self.hi - 1] + gap

@@ -11,13 +11,13 @@ follower i - 1 in a chain), in index order, every agent at its state of the tick
 
     (C1) record p_t into the target's path; s_k its progress     (convoy_path.TargetPath)
     (C2) sigma*_k, q_k = P(sigma*_k)                              (convoy_path.Goal)
-    (C3) r''_0 = clamp_norm(w_r^2 (q - r) + 2 z_r w_r (q' - r'), a_max),  q' = (q_k - q_{k-1}) / T
+    (C3) v* = clamp_norm(q' + clamp_norm((w_r / (2 z_r)) (q - r), c), |v_t| + c),
+         r''_0 = clamp_norm(2 z_r w_r (v* - r'), a_max),  q' = (q_k - q_{k-1}) / T
     (C5) c = |p_t - r|, n = (p_t - r) / c, v_r = n.r', v_t = n.v_t,
          h = c - c_min - max(v_r, 0)^2 / (2 a_b) + max(v_t, 0)^2 / (2 A),  c_min = (1 + m/2)|d_i|
-         n.r'' <= max(-a_max, a_b (w_r h + min(0, v_t) - v_r) / max(v_r, a_b T)): where r''_0
-         exceeds it, its component along n is set to the bound (`braking`); the part across n
-         is r''_0's, within a_max already ("kept within a_max" read literally: |r''| may then
-         exceed a_max, up to sqrt(2) a_max, where the bound is below -|n.r''_0|)
+         N = w_r h + min(0, v_t) - v_r, delta = max(v_r, a_b T) if N < 0 else max(v_r, a_b / w_r),
+         n.r'' <= max(-a_max, a_b N / delta): where r''_0 exceeds it, its component along n is
+         set to the bound (`braking`) and its part across n scaled down to keep |r''| <= a_max
     (C4) xi = [r - p_i; r' - v_i],  u_i = G y + r''  (y = xi, C = I)
 
 then r, r' and every plant are integrated exactly over [t_k, t_k + T] with r'' and u_i held
@@ -142,6 +142,12 @@ def load(path, overrides):
     return (sc,) + formation
 
 
+def clamp_norm(v, limit):
+    """v scaled down to norm limit when longer."""
+    norm = math.sqrt(float(v @ v))
+    return v * (limit / norm) if norm > limit else v
+
+
 class ConvoyReference:
     """r, r' of one follower (C3)-(C5) on its target's path (C1), toward its goal (C2)."""
 
@@ -165,10 +171,9 @@ class ConvoyReference:
         sigma, q = self.goal.tick(self.path, p)
         qd = (q - self.q_prev) / T
         self.q_prev = q
-        acc = self.w ** 2 * (q - self.r) + 2.0 * self.z * self.w * (qd - self.rd)
-        norm = math.sqrt(float(acc @ acc))
-        if norm > prm.max_acceleration:
-            acc = acc * (prm.max_acceleration / norm)                    # (C3)
+        approach = clamp_norm(self.w / (2.0 * self.z) * (q - self.r), prm.catch_up_speed)
+        speed = clamp_norm(qd + approach, math.sqrt(float(v @ v)) + prm.catch_up_speed)
+        acc = clamp_norm(2.0 * self.z * self.w * (speed - self.rd), prm.max_acceleration)  # (C3)
         rel = p - self.r
         chord = math.sqrt(float(rel @ rel))
         braking = False
@@ -178,11 +183,14 @@ class ConvoyReference:
             ab = prm.braking_acceleration
             h = (chord - self.c_min - max(v_r, 0.0) ** 2 / (2.0 * ab)
                  + max(v_t, 0.0) ** 2 / (2.0 * prm.target_braking))
-            bound = max(-prm.max_acceleration,
-                        ab * (self.w * h + min(0.0, v_t) - v_r) / max(v_r, ab * T))
+            numerator = self.w * h + min(0.0, v_t) - v_r
+            delta = max(v_r, ab * T if numerator < 0.0 else ab / self.w)
+            bound = max(-prm.max_acceleration, ab * numerator / delta)
             along = float(n @ acc)
             if along > bound:
-                acc = acc + (bound - along) * n
+                across = clamp_norm(acc - along * n,
+                                    math.sqrt(max(0.0, prm.max_acceleration ** 2 - bound ** 2)))
+                acc = bound * n + across
                 braking = True
         sample = (self.r.copy(), self.rd.copy(), acc, q, s, sigma, chord, braking)
         self.r = self.r + self.rd * T + 0.5 * T * T * acc
