@@ -27,6 +27,7 @@ void TargetPath::reset(const Eigen::Vector3d& start, const Eigen::Vector3d& dire
   push(tip_, 0.0);
   progress_ = 0.0;
   retracing_ = false;
+  start_kept_ = true;
 }
 
 const Eigen::Vector3d& TargetPath::point(int i) const {
@@ -41,6 +42,7 @@ void TargetPath::push(const Eigen::Vector3d& position, double sigma) {
   if (count_ == capacity_) {  // the oldest point goes
     first_ = (first_ + 1) % capacity_;
     --count_;
+    start_kept_ = false;
   }
   const auto slot = static_cast<std::size_t>((first_ + count_) % capacity_);
   points_[slot] = position;
@@ -49,7 +51,7 @@ void TargetPath::push(const Eigen::Vector3d& position, double sigma) {
 }
 
 Eigen::Vector3d TargetPath::oldestDirection() const {
-  if (count_ >= 2) {
+  if (!start_kept_ && count_ >= 2) {
     const Eigen::Vector3d segment = point(1) - point(0);
     const double length = segment.norm();
     if (length > 0.0) {

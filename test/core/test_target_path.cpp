@@ -159,7 +159,7 @@ TEST(TargetPath, AtIsContinuousAndExactOnRecordedPoints) {
   EXPECT_NEAR(beyond.norm(), 1.0, 1e-9);
 }
 
-TEST(TargetPath, VirtualRoadRunsBackAlongTheOldestSegmentOrTheResetDirection) {
+TEST(TargetPath, VirtualRoadRunsBackAlongTheResetDirectionWhileTheStartIsKept) {
   const Eigen::Vector3d start(1.0, 2.0, -1.0);
   TargetPath path(64, kSpacing, 0.5);
   path.reset(start, Eigen::Vector3d(0.0, 2.0, 0.0));  // not unit: normalised
@@ -172,16 +172,16 @@ TEST(TargetPath, VirtualRoadRunsBackAlongTheOldestSegmentOrTheResetDirection) {
   path.reset(start, Eigen::Vector3d(std::nan(""), 1.0, 0.0));
   EXPECT_LT((path.at(-2.0) - (start - 2.0 * Eigen::Vector3d::UnitX())).norm(), 1e-12);
 
-  // Once the target drove (here at right angles to the reset direction), the road goes on along
-  // the oldest segment.
+  // The target drives off at right angles to the reset direction: the road stays the one the
+  // convoy came on, along the reset direction, as long as the start is the oldest point.
   path.reset(start, Eigen::Vector3d::UnitY());
-  const Eigen::Vector3d e = Eigen::Vector3d(3.0, 0.0, 4.0) / 5.0;
+  const Eigen::Vector3d e = Eigen::Vector3d(3.0, 0.0, 4.0) / 5.0;  // the first leg
   driveTo(&path, start, start + 2.0 * e, 0.01);
   driveTo(&path, start + 2.0 * e, start + 2.0 * e + Eigen::Vector3d(0.0, 1.0, 0.0), 0.01);
   ASSERT_GE(path.size(), 2);
   EXPECT_EQ(path.oldestArc(), 0.0);
   for (const double tau : {0.1, 1.0, 7.5}) {
-    EXPECT_LT((path.at(-tau) - (start - tau * e)).norm(), 1e-9) << tau;
+    EXPECT_LT((path.at(-tau) - (start - tau * Eigen::Vector3d::UnitY())).norm(), 1e-12) << tau;
   }
 }
 

@@ -10,8 +10,8 @@ convoy_reference.py. The follower records its target's position p_t at each tick
      target's progress s is the arc of p_t itself: s = arc(latest point) + |p_t - latest|.
      - From the latest point P goes straight to the target.
      - Before the oldest point P goes on straight backward (the virtual road): along the
-       oldest segment's direction, or, while only one point is recorded, along the direction
-       given at the start (d_i's position part: the road lies behind the target).
+       direction given at the start (d_i's position part: the road lies behind the target)
+       while the start is the oldest point, then along the oldest segment's direction.
      - Retrace: while p_t is behind the latest point along the latest segment and within
        `retrace_width` of that segment's line, the latest point is taken off, so s goes down
        while the target reverses. With one point left, behind it along the road, the point
@@ -55,8 +55,9 @@ class TargetPath:
         return unit(self.pts[i + 1] - self.pts[i])
 
     def road_direction(self):
-        """Forward direction of the virtual road before the oldest point."""
-        if self.hi - self.lo >= 2:
+        """Forward direction of the virtual road before the oldest point: the start's while the
+        start is kept, then the oldest segment's."""
+        if self.lo > 0 and self.hi - self.lo >= 2:
             return self._direction(self.lo)
         return self.start_direction
 

@@ -20,8 +20,8 @@ namespace projection_collision_avoidance {
 ///    position beside the latest segment (within @p retrace_width, less than @p spacing ahead)
 ///    adds no point, so a reversing target that drifts sideways stays on its path;
 ///  - the path goes on from the latest point straight to the target, s = sigma_last + ||p_t −
-///    P_last||, and before the oldest point it goes on straight backward (along the oldest
-///    segment, or the initial direction while there is one point): a virtual road behind it.
+///    P_last||, and before the oldest point it goes on straight backward: a virtual road behind
+///    it, along the initial direction while the start is kept, then along the oldest segment.
 /// P is continuous in sigma. Every function allocates nothing after construction.
 class TargetPath {
  public:
@@ -74,7 +74,8 @@ class TargetPath {
   Eigen::Vector3d direction_ = Eigen::Vector3d::UnitX();  ///< initial forward direction
   Eigen::Vector3d tip_ = Eigen::Vector3d::Zero();         ///< the target's latest position
   double progress_ = 0.0;
-  bool retracing_ = false;  ///< points were taken off since the latest one was added
+  bool retracing_ = false;   ///< points were taken off since the latest one was added
+  bool start_kept_ = true;   ///< the start is the oldest point: the road keeps direction_
 };
 
 }  // namespace projection_collision_avoidance
