@@ -32,10 +32,6 @@ FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh,
   const ControllerDesign& design = controller->design();
   FollowerNodeOptions options =
       readFollowerOptions(reader, parameters, member, ros::Time::isSimTime());
-  if (configuration.formation.slots == SlotFrame::kPath) {
-    throw ParameterError("formation.slots",
-                         "path (convoys) runs in cf_sim; the follower node takes world or turning");
-  }
   if (configuration.formation.slots == SlotFrame::kTurning) {
     options.turning = configuration.formation.turning;
   }
