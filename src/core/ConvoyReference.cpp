@@ -103,7 +103,7 @@ Eigen::Vector3d ConvoyReference::acceleration(const Eigen::Vector3d& goal,
   // (C5): the stopping-distance barrier h = c − c_min − v_r^2 / (2 a_b) + v_t^2 / (2 A), kept
   // by n . r'' <= a_b (omega h + min(0, n . v_t) − n . r') / max(v_r, a_b T), at least −a_max.
   const Eigen::Vector3d along = to_target / chord;
-  const double reference_speed = along.dot(velocity_);      // toward the target
+  const double reference_speed = along.dot(velocity_);     // toward the target
   const double target_speed = along.dot(target_velocity);  // away from the reference
   const double braking_limit = parameters_.braking_acceleration;
   const double reference_stop = std::max(0.0, reference_speed);

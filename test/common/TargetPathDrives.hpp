@@ -18,7 +18,7 @@ inline Eigen::Vector3d onCircle(double radius, double angle) {
 
 /// Drives @p path in straight steps of at most @p step from @p from to @p to (both recorded).
 inline void driveTo(TargetPath* path, const Eigen::Vector3d& from, const Eigen::Vector3d& to,
-             double step) {
+                    double step) {
   const int steps = std::max(1, static_cast<int>(std::ceil((to - from).norm() / step - 1e-9)));
   for (int k = 1; k <= steps; ++k) {
     path->record(from + (to - from) * (static_cast<double>(k) / steps));

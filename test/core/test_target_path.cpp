@@ -10,8 +10,9 @@
 #include <Eigen/Core>
 #include <gtest/gtest.h>
 
-#include "TargetPathDrives.hpp"
 #include "projection_collision_avoidance/core/TargetPath.hpp"
+
+#include "TargetPathDrives.hpp"
 
 namespace projection_collision_avoidance {
 namespace {
@@ -33,7 +34,6 @@ void expectArcLengthParametrised(const TargetPath& path, double from, double to)
     previous = current;
   }
 }
-
 
 TEST(TargetPath, RecordsPointsSpacingApartAndProgressIsTheDistanceDriven) {
   TargetPath path(64, kSpacing, 0.5);

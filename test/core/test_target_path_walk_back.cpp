@@ -8,8 +8,9 @@
 #include <Eigen/Core>
 #include <gtest/gtest.h>
 
-#include "TargetPathDrives.hpp"
 #include "projection_collision_avoidance/core/TargetPath.hpp"
+
+#include "TargetPathDrives.hpp"
 
 namespace projection_collision_avoidance {
 namespace {

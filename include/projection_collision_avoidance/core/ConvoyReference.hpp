@@ -103,8 +103,8 @@ class ConvoyReference {
 
   ConvoyParameters parameters_;
   double period_;
-  double gap_;         ///< g (m)
-  double goal_chord_;  ///< ||d|| + margin (m)
+  double gap_;          ///< g (m)
+  double goal_chord_;   ///< ||d|| + margin (m)
   double floor_chord_;  ///< c_min = ||d|| + margin / 2 (m)
   TargetPath path_;
   Eigen::Vector3d position_ = Eigen::Vector3d::Zero();

@@ -74,8 +74,8 @@ class TargetPath {
   Eigen::Vector3d direction_ = Eigen::Vector3d::UnitX();  ///< initial forward direction
   Eigen::Vector3d tip_ = Eigen::Vector3d::Zero();         ///< the target's latest position
   double progress_ = 0.0;
-  bool retracing_ = false;   ///< points were taken off since the latest one was added
-  bool start_kept_ = true;   ///< the start is the oldest point: the road keeps direction_
+  bool retracing_ = false;  ///< points were taken off since the latest one was added
+  bool start_kept_ = true;  ///< the start is the oldest point: the road keeps direction_
 };
 
 }  // namespace projection_collision_avoidance
