@@ -45,7 +45,6 @@ every difference is then 0).
 import argparse
 import concurrent.futures
 import os
-import subprocess
 import sys
 import tempfile
 from dataclasses import dataclass
@@ -53,12 +52,13 @@ from pathlib import Path
 
 import numpy as np
 
-PYTHON = "/usr/bin/python3"
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from compare_common import run_tool, write_xunit  # noqa: E402  (beside this file)
+
 HERE = Path(__file__).resolve().parent
 DEFAULT_REFERENCE = HERE / "convoy_reference.py"
 TOLERANCE = 1e-6          # m
 XI_SLACK = 1e-9           # m: cf_sim's follower on its reference, (C4)
-TIMEOUT_S = 300
 
 PATH_SLOTS = ("formation.slots=path",)
 
@@ -111,10 +111,6 @@ CASES = (
 )
 
 
-def tool_command(path):
-    return [PYTHON, str(path)] if str(path).endswith(".py") else [str(path)]
-
-
 def parse_summaries(stdout):
     """{follower_<i>: {key: value}} of the ``follower_<i> target=..`` lines."""
     out = {}
@@ -135,24 +131,6 @@ def read_csv(path):
         names = fh.readline().strip().split(",")
     data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
     return {name: data[:, i] for i, name in enumerate(names)}
-
-
-def run_tool(tool, scenario, overrides, csv):
-    """Run a tool with --csv; return (summaries, None) or (None, error text)."""
-    argv = tool_command(tool) + [str(scenario), "--csv", str(csv)]
-    for assignment in overrides:
-        argv += ["--set", assignment]
-    try:
-        proc = subprocess.run(argv, capture_output=True, text=True, timeout=TIMEOUT_S)
-    except (OSError, subprocess.TimeoutExpired) as exc:
-        return None, f"{Path(tool).name}: {exc}"
-    if proc.returncode != 0:
-        err = (proc.stderr.strip().splitlines() or ["(no stderr)"])[-1]
-        return None, f"{Path(tool).name} exited {proc.returncode}: {err}"
-    try:
-        return parse_summaries(proc.stdout), None
-    except (ValueError, KeyError) as exc:
-        return None, f"{Path(tool).name}: {exc}"
 
 
 def columns(cols, prefix):
@@ -212,9 +190,10 @@ def check_case(case, cf_sim, reference, scenarios_dir, keep=None):
         work = Path(keep) / case.name if keep else Path(tmp)
         work.mkdir(parents=True, exist_ok=True)
         with concurrent.futures.ThreadPoolExecutor(max_workers=2) as pool:
-            cf_job = pool.submit(run_tool, cf_sim, scenario, case.overrides, work / "cf_sim.csv")
-            ref_job = pool.submit(run_tool, reference, scenario, case.overrides,
-                                  work / "reference.csv")
+            cf_job = pool.submit(run_tool, cf_sim, [scenario, "--csv", work / "cf_sim.csv"],
+                                 case.overrides, parse_summaries, (ValueError, KeyError))
+            ref_job = pool.submit(run_tool, reference, [scenario, "--csv", work / "reference.csv"],
+                                  case.overrides, parse_summaries, (ValueError, KeyError))
             (cf, cf_err), (ref, ref_err) = cf_job.result(), ref_job.result()
         if cf_err or ref_err:
             return False, f"FAIL {case.name}: " + "; ".join(e for e in (cf_err, ref_err) if e)
@@ -234,21 +213,6 @@ def check_case(case, cf_sim, reference, scenarios_dir, keep=None):
     if problems:
         line += " -- " + "; ".join(problems)
     return not problems, line
-
-
-def write_xunit(path, results):
-    """Writes the cases as a JUnit XML file (read by catkin_test_results)."""
-    import xml.etree.ElementTree as ET
-    suite = ET.Element("testsuite", name="compare_convoy", tests=str(len(results)),
-                       failures=str(sum(1 for _, ok, _ in results if not ok)), errors="0")
-    for name, ok, line in results:
-        case = ET.SubElement(suite, "testcase", classname="compare_convoy", name=name)
-        if not ok:
-            ET.SubElement(case, "failure", message=line).text = line
-        else:
-            ET.SubElement(case, "system-out").text = line
-    os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
-    ET.ElementTree(suite).write(path, encoding="utf-8", xml_declaration=True)
 
 
 def main(argv=None):
@@ -286,7 +250,7 @@ def main(argv=None):
     failed = sum(1 for _, ok, _ in results if not ok)
     print(f"{len(results) - failed} passed, {failed} failed")
     if args.xunit:
-        write_xunit(args.xunit, results)
+        write_xunit(args.xunit, "compare_convoy", results)
     return 1 if failed else 0
 
 

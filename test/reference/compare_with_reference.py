@@ -51,12 +51,13 @@ import argparse
 import concurrent.futures
 import math
 import os
-import subprocess
 import sys
 from dataclasses import dataclass
 from pathlib import Path
 
-PYTHON = "/usr/bin/python3"
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from compare_common import run_tool, write_xunit  # noqa: E402  (beside this file)
+
 HERE = Path(__file__).resolve().parent
 DEFAULT_REFERENCE = HERE / "reference_sim.py"
 COMPARED = ("max_xi", "max_xi_hat", "min_separation")
@@ -271,11 +272,6 @@ CASES = (
 )
 
 
-def tool_command(path):
-    """argv prefix that runs a tool; Python scripts go through /usr/bin/python3."""
-    return [PYTHON, str(path)] if str(path).endswith(".py") else [str(path)]
-
-
 def _value(text):
     try:
         return float(text)
@@ -312,24 +308,6 @@ def parse_summaries(stdout):
     return agents, formation
 
 
-def run_tool(tool, scenario_path, overrides, extra_args=()):
-    """Run one tool on a case; return ((agents, formation), None) or (None, error text)."""
-    argv = tool_command(tool) + [str(scenario_path)] + list(extra_args)
-    for assignment in overrides:
-        argv += ["--set", assignment]
-    try:
-        proc = subprocess.run(argv, capture_output=True, text=True, timeout=TIMEOUT_S)
-    except (OSError, subprocess.TimeoutExpired) as exc:
-        return None, f"{Path(tool).name}: {exc}"
-    if proc.returncode != 0:
-        err = (proc.stderr.strip().splitlines() or ["(no stderr)"])[-1]
-        return None, f"{Path(tool).name} exited {proc.returncode}: {err}"
-    try:
-        return parse_summaries(proc.stdout), None
-    except ValueError as exc:
-        return None, f"{Path(tool).name}: {exc}"
-
-
 def compare_agent(label, cf, ref, tolerance, parts, problems):
     """Compare one agent's summary (a pair or a follower); append to parts and problems."""
     prefix = f"{label}: " if label != "pair" else ""
@@ -363,8 +341,10 @@ def check_case(case, cf_sim, reference, scenarios_dir, tolerance, cf_args=(), re
     if not scenario.is_file():
         return False, f"FAIL {case.name}: no scenario file {scenario}"
     with concurrent.futures.ThreadPoolExecutor(max_workers=2) as pool:
-        cf_future = pool.submit(run_tool, cf_sim, scenario, case.overrides, cf_args)
-        ref_future = pool.submit(run_tool, reference, scenario, case.overrides, ref_args)
+        cf_future = pool.submit(run_tool, cf_sim, [scenario, *cf_args], case.overrides,
+                                parse_summaries, (ValueError,), TIMEOUT_S)
+        ref_future = pool.submit(run_tool, reference, [scenario, *ref_args], case.overrides,
+                                 parse_summaries, (ValueError,), TIMEOUT_S)
         (cf, cf_err), (ref, ref_err) = cf_future.result(), ref_future.result()
     if cf_err or ref_err:
         return False, f"FAIL {case.name}: " + "; ".join(e for e in (cf_err, ref_err) if e)
@@ -456,23 +436,8 @@ def main(argv=None):
             failed += not ok
     print(f"{passed} passed, {failed} failed")
     if args.xunit:
-        write_xunit(args.xunit, results)
+        write_xunit(args.xunit, "compare_with_reference", results)
     return 1 if failed else 0
-
-
-def write_xunit(path, results):
-    """Writes the cases as a JUnit XML file (read by catkin_test_results)."""
-    import xml.etree.ElementTree as ET
-    suite = ET.Element("testsuite", name="compare_with_reference", tests=str(len(results)),
-                       failures=str(sum(1 for _, ok, _ in results if not ok)), errors="0")
-    for name, ok, line in results:
-        case = ET.SubElement(suite, "testcase", classname="compare_with_reference", name=name)
-        if not ok:
-            ET.SubElement(case, "failure", message=line).text = line
-        else:
-            ET.SubElement(case, "system-out").text = line
-    os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
-    ET.ElementTree(suite).write(path, encoding="utf-8", xml_declaration=True)
 
 
 if __name__ == "__main__":
