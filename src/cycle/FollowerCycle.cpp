@@ -46,6 +46,11 @@ FollowerCycle::FollowerCycle(std::unique_ptr<DynamicFollowerController> controll
   if (settings_.turning) {
     slot_heading_.emplace(*settings_.turning, period_);
   }
+  if (settings_.path) {
+    path_slot_.emplace(
+        *settings_.path, period_, separation_,
+        static_cast<int>(handover_.current().design().parameters.model.position_dimension));
+  }
 }
 
 FollowerCycle::~FollowerCycle() = default;
@@ -147,7 +152,7 @@ bool FollowerCycle::step(std::int64_t now_ns, std::int64_t stamp_ns, double dela
   if (use_leader) {
     inputs.leader_input.emplace(inputs_.leader().acceleration);
   }
-  if (slot_heading_) {
+  if (slot_heading_ || path_slot_) {
     inputs.slot_acceleration.emplace(slot_acceleration_);
   }
   const DynamicFollowerStatus* status = &controller.step(inputs);
@@ -167,6 +172,9 @@ bool FollowerCycle::turnSlot(std::int64_t stamp_ns, const GenericDimensions::Sta
                              FollowerCycleOutput* out) {
   out->slot = separation_;
   out->heading_known = false;
+  if (path_slot_) {
+    return pathSlot(stamp_ns, state, out);
+  }
   if (!slot_heading_) {
     return true;
   }
@@ -191,6 +199,24 @@ bool FollowerCycle::turnSlot(std::int64_t stamp_ns, const GenericDimensions::Sta
   turningSlotOffset(separation_, static_cast<int>(axes), out->slot_heading, &out->slot);
   turningSlotAcceleration(separation_, static_cast<int>(axes), out->slot_heading,
                           &slot_acceleration_);
+  return true;
+}
+
+bool FollowerCycle::pathSlot(std::int64_t stamp_ns, const GenericDimensions::StateVector& state,
+                             FollowerCycleOutput* out) {
+  const bool own_fresh = inputs_.ownStateAge(stamp_ns) <= settings_.measurement_timeout;
+  const bool known = own_fresh && mode_ != FollowerMode::kMeasurementLost;
+  if (!path_slot_->started() && !known) {
+    return false;  // the path starts at the target's first known position
+  }
+  if (!own_fresh) {
+    mode_ = FollowerMode::kMeasurementLost;  // no target state: brake
+    out->mode = mode_;
+  }
+  const OwnStateSample& own = inputs_.ownState();
+  path_slot_->step(known, own.controlled_position, own.controlled_velocity, state, &out->slot,
+                   &slot_acceleration_);
+  out->heading_known = known;
   return true;
 }
 

@@ -8,7 +8,6 @@
 #include <ros/init.h>
 
 #include "projection_collision_avoidance/configuration/ConfigurationLoader.hpp"
-#include "projection_collision_avoidance/core/Formation.hpp"
 #include "projection_collision_avoidance/core/ParameterError.hpp"
 #include "projection_collision_avoidance/cycle/FrameNames.hpp"
 
@@ -161,11 +160,6 @@ FollowerConfiguration loadFollowerConfiguration(const ros::NodeHandle& private_n
   options.cancelled = nodeShuttingDown;
   options.check = [](const FollowerConfiguration& configuration) {
     requireNodeController(configuration.controller);
-    if (configuration.formation.slots == SlotFrame::kPath) {
-      throw ParameterError("formation.slots",
-                           "path (convoys) runs in cf_sim; the follower node takes world or "
-                           "turning");
-    }
   };
   FollowerConfiguration configuration;
   readScenarioParameter(

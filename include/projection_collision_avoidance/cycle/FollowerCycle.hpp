@@ -16,6 +16,7 @@
 #include "projection_collision_avoidance/cycle/ControllerHandover.hpp"
 #include "projection_collision_avoidance/cycle/InputTimeline.hpp"
 #include "projection_collision_avoidance/cycle/LatchedInputs.hpp"
+#include "projection_collision_avoidance/cycle/PathSlot.hpp"
 #include "projection_collision_avoidance/cycle/StallWait.hpp"
 #include "projection_collision_avoidance/cycle/StepPacer.hpp"
 #include "projection_collision_avoidance/cycle/TimeJumpWatch.hpp"
@@ -38,6 +39,8 @@ struct FollowerCycleSettings {
   /// Turning slots (formation.slots: turning): the slot heading's generator (T1); empty: d fixed
   /// in the world.
   std::optional<SlotHeadingParameters> turning;
+  /// Path slots (formation.slots: path): the convoy's reference (C1)-(C5); empty: no convoy.
+  std::optional<ConvoyParameters> path;
 };
 
 /// What a tick or step gives the outputs: the step's results when one ran, and the counters.
@@ -63,7 +66,9 @@ struct FollowerCycleOutput {
   GenericDimensions::StateVector slot;
   SlotHeadingSample slot_heading;  ///< theta, theta', theta'' of a turning slot (T1); else 0
   /// Turning slots: the step had the target's heading (own odometry and measurement fresh, the
-  /// target faster than formation.turning.min_speed); else the slot stopped turning
+  /// target faster than formation.turning.min_speed); else the slot stopped turning. Path slots:
+  /// the step had the target's state (own odometry and measurement fresh); else the reference's
+  /// goal held and the step braked
   bool heading_known = false;
   double distance = 0.0;         ///< ||p_target - p_i|| of that measurement (m)
   DynamicFollowerStatus status;  ///< the controller's step
@@ -93,10 +98,13 @@ struct FollowerCycleOutput {
 /// measurement timeout (StepInputs::own_state), else leaves the headway
 /// out. With turning slots (FollowerCycleSettings::turning) the slot turns with the heading of the
 /// target's velocity, its own (odometry) plus the measured relative velocity, (T1)-(T3): the first
-/// step waits for the own state, which sets theta(0). Nothing in tick() or stepOnMeasurement()
-/// allocates, locks (except under the measurement
-/// trigger, whose steps run in the measurement's callback, and a tick waits for a step running
-/// there) or makes a system call, so that a real-time thread can run it.
+/// step waits for the own state, which sets theta(0). With path slots (FollowerCycleSettings::path)
+/// the slot is a reference point on the target's path, the target's state being the own
+/// (odometry) plus the measured relative state (PathSlot); the first step waits for the own
+/// state, and a step without a fresh own state brakes (mode measurement_lost). Nothing in tick() or
+/// stepOnMeasurement() allocates, locks (except under the measurement trigger, whose steps run in
+/// the measurement's callback, and a tick waits for a step running there) or makes a system call,
+/// so that a real-time thread can run it.
 ///
 /// Time: every call reads the ROS time `now_ns` after it has latched the inputs. An input is valid
 /// while it was received at or before now (after a jump back of ROS time, those of the old timeline
@@ -217,6 +225,10 @@ class FollowerCycle {
   /// step must wait for the own state.
   bool turnSlot(std::int64_t stamp_ns, const GenericDimensions::StateVector& state,
                 FollowerCycleOutput* out);
+  /// D and u_r of a path slot (PathSlot); false when the first step must wait for the own state.
+  /// A step without a fresh own state is one of mode measurement_lost.
+  bool pathSlot(std::int64_t stamp_ns, const GenericDimensions::StateVector& state,
+                FollowerCycleOutput* out);
   /// The counters and the design in force into @p out (whether or not a step ran).
   void fillCounters(std::int64_t now_ns, FollowerCycleOutput* out) const;
   /// Notes ROS time @p now_ns: a jump back is counted, and the stamps start afresh.
@@ -227,6 +239,7 @@ class FollowerCycle {
   FollowerCycleSettings settings_;
   std::optional<SlotHeading> slot_heading_;           ///< theta (T1) of a turning slot
   bool heading_started_ = false;                      ///< theta(0) set by the first step
+  std::optional<PathSlot> path_slot_;                 ///< r (C1)-(C5) of a path slot
   GenericDimensions::InputVector slot_acceleration_;  ///< u_r (T3) of the step
   double period_ = 0.0;
   std::mutex trigger_mutex_;  ///< measurement trigger only: callback steps vs braking ticks

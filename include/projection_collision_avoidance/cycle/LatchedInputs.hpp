@@ -32,8 +32,11 @@ struct OwnStateSample {
   GenericDimensions::StateVector state;  ///< x_i (m, m/s)
   /// The velocity of the follower's controlled point, the point the relative measurement is of
   /// (the origin's, or a look-ahead point's) (m/s, one entry per axis): with the measured relative
-  /// velocity, the target's (turning slots).
+  /// velocity, the target's (turning and path slots).
   GenericDimensions::InputVector controlled_velocity;
+  /// The controlled point's position (m, one entry per axis): with the measured relative
+  /// position, the target's (path slots).
+  GenericDimensions::InputVector controlled_position;
 };
 
 /// The follower's input slots, lock-free triple buffers (LatestValue) that the input callbacks

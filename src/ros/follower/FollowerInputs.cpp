@@ -33,6 +33,7 @@ FollowerInputs::FollowerInputs(std::string node_name, const FollowerNodeOptions&
   leader_.acceleration.setZero(axes_);
   own_state_.state.setZero(2 * axes_);
   own_state_.controlled_velocity.setZero(axes_);
+  own_state_.controlled_position.setZero(axes_);
   relative_state_ = Eigen::VectorXd::Zero(2 * axes_);
   odometry_state_ = Eigen::VectorXd::Zero(2 * axes_);
 }
@@ -52,7 +53,7 @@ void FollowerInputs::start(ros::NodeHandle node) {
   }
   leader_subscriber_ =
       nh.subscribe("leader_broadcast", 10, &FollowerInputs::onLeaderBroadcast, this, link);
-  if (design_.parameters.time_headway > 0.0 || options_.turning) {
+  if (design_.parameters.time_headway > 0.0 || options_.turning || options_.path) {
     odometry_subscriber_ = nh.subscribe("odom", 10, &FollowerInputs::onOdometry, this,
                                         ros::TransportHints().tcpNoDelay());
   }
@@ -211,11 +212,12 @@ void FollowerInputs::onOdometry(const ros::MessageEvent<nav_msgs::Odometry const
     }
     odometry_state_ = origin_state_;
     own_state_.controlled_velocity = origin_state_.tail(axes_);
+    own_state_.controlled_position = origin_state_.head(axes_);
     const double look_ahead =
         options_.input == MeasurementInput::kOdometry              ? options_.odometry.look_ahead
         : options_.input == MeasurementInput::kRelativeMeasurement ? 0.0
                                                                    : options_.position.look_ahead;
-    if (options_.turning && look_ahead > 0.0) {
+    if ((options_.turning || options_.path) && look_ahead > 0.0) {
       // The look-ahead point, which the relative measurement (~input odometry, tf or position) is
       // taken at.
       const Eigen::Matrix<double, 6, 1> point = bodyPointState(
@@ -223,6 +225,7 @@ void FollowerInputs::onOdometry(const ros::MessageEvent<nav_msgs::Odometry const
           options_.odometry.twist_in_body_frame ? TwistFrame::kBody : TwistFrame::kWorld);
       if (point.allFinite()) {
         own_state_.controlled_velocity = point.segment(3, axes_);
+        own_state_.controlled_position = point.head(axes_);
       }
     }
     own_state_.stamp_ns = timeline.accept();

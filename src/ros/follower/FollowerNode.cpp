@@ -35,6 +35,14 @@ FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh,
   if (configuration.formation.slots == SlotFrame::kTurning) {
     options.turning = configuration.formation.turning;
   }
+  if (configuration.formation.slots == SlotFrame::kPath) {
+    if (options.trigger == ControlTrigger::kMeasurement) {
+      throw ParameterError("~trigger",
+                           "must be timer with formation.slots: path (the reference "
+                           "moves one control period per step)");
+    }
+    options.path = configuration.formation.path;
+  }
   if (options.lock_memory) {
     try {
       lockProcessMemory();
@@ -56,6 +64,7 @@ FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh,
   settings.use_leader_input = options.use_leader_broadcast;
   settings.measurement_trigger = options.trigger == ControlTrigger::kMeasurement;
   settings.turning = options.turning;
+  settings.path = options.path;
   const ControllerDesign start = design;
   cycle_ = std::make_unique<FollowerCycle>(std::move(controller), parameters.separation, settings);
   try {
@@ -117,7 +126,10 @@ FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh,
                                : std::string())
                        << (options.turning ? ", turning slot (heading from " +
                                                  inputs_->odometryTopic() + " and the measurement)"
-                                           : std::string()));
+                                           : std::string())
+                       << (options.path ? ", path slot (the target's path from " +
+                                              inputs_->odometryTopic() + " and the measurement)"
+                                        : std::string()));
 }
 
 FollowerNode::~FollowerNode() { stop(); }

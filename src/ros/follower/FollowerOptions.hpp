@@ -106,6 +106,9 @@ struct FollowerNodeOptions {
   /// heading of the target's velocity, from the own odometry `odom` and the measurement); empty:
   /// world slots.
   std::optional<SlotHeadingParameters> turning;
+  /// The scenario's formation.path with formation.slots: path (a convoy on the target's path, its
+  /// state from the own odometry `odom` and the measurement); empty: other slots.
+  std::optional<ConvoyParameters> path;
   /// ~trigger: "timer" (default) or "measurement"; see FollowerNode.
   ControlTrigger trigger = ControlTrigger::kTimer;
   /// ~control_loop: "timer" (default) or "thread" (wall time only); see FollowerNode.
