@@ -14,8 +14,10 @@
 #                                 cmd_vel, star, V, t = 21.5 s (during the push), formation.rviz
 #   doc/rviz_formation_turning.png  figure_eight_2d, 4 followers, star, V, slots:=turning,
 #                                 t = 13 s (the leader turning round a loop), formation.rviz
-# Usage: experiments/formation_screenshots/run.sh [2d] [3d] [chain] [vehicles] [turning]
-#   (default: all five; ~1 min each)
+#   doc/rviz_formation_path.png   figure_eight_2d, 4 followers, chain, line, slots:=path,
+#                                 t = 13 s (the convoy on the leader's loop), formation.rviz
+# Usage: experiments/formation_screenshots/run.sh [2d] [3d] [chain] [vehicles] [turning] [path]
+#   (default: all six; ~1 min each)
 #   OUT_DIR (default doc/), REAL_TIME_FACTOR (default 0.5), ROS_PORT (default 11412: its own
 #   master, apart from other tests), SCREEN_DISPLAY (default :98). Needs a built workspace
 #   (scripts/build.sh). The PNGs are reduced to 256 colours (ImageMagick `convert`).
@@ -25,7 +27,7 @@ out=${OUT_DIR:-$root/doc}
 rtf=${REAL_TIME_FACTOR:-0.5}
 port=${ROS_PORT:-11412}
 shots=("$@")
-(( ${#shots[@]} )) || shots=(2d 3d chain vehicles turning)
+(( ${#shots[@]} )) || shots=(2d 3d chain vehicles turning path)
 launch=formation.launch  # the launch file of the current shot
 test -f "$root/build/devel/setup.bash" || "$root/scripts/build.sh" >/dev/null
 set +u  # the workspace's setup scripts read unset variables
@@ -112,9 +114,12 @@ for shot in "${shots[@]}"; do
     turning) shoot 13 "$out/rviz_formation_turning.png" "$root/rviz/formation.rviz" \
           scenario:="$root/config/scenarios/figure_eight_2d.yaml" followers:=4 topology:=star \
           shape:=v slots:=turning ;;
+    path) shoot 13 "$out/rviz_formation_path.png" "$root/rviz/formation.rviz" \
+          scenario:="$root/config/scenarios/figure_eight_2d.yaml" followers:=4 topology:=chain \
+          shape:=line slots:=path ;;
     vehicles) launch=vehicles.launch
           shoot 21.5 "$out/rviz_vehicles.png" "$root/rviz/formation.rviz" followers:=3 kind:=unicycle
           launch=formation.launch ;;
-    *) echo "formation_screenshots: unknown shot '$shot' (2d, 3d, chain, vehicles, turning)"; exit 1 ;;
+    *) echo "formation_screenshots: unknown shot '$shot' (2d, 3d, chain, vehicles, turning, path)"; exit 1 ;;
   esac
 done
