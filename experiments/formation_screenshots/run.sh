@@ -15,7 +15,8 @@
 #   doc/rviz_formation_turning.png  figure_eight_2d, 4 followers, star, V, slots:=turning,
 #                                 t = 13 s (the leader turning round a loop), formation.rviz
 #   doc/rviz_formation_path.png   figure_eight_2d, 4 followers, chain, line, slots:=path,
-#                                 t = 13 s (the convoy on the leader's loop), formation.rviz
+#                                 t = 13 s (the convoy on the leader's loop), seen from above
+#                                 (rviz/formation_path.rviz)
 # Usage: experiments/formation_screenshots/run.sh [2d] [3d] [chain] [vehicles] [turning] [path]
 #   (default: all six; ~1 min each)
 #   OUT_DIR (default doc/), REAL_TIME_FACTOR (default 0.5), ROS_PORT (default 11412: its own
@@ -114,7 +115,7 @@ for shot in "${shots[@]}"; do
     turning) shoot 13 "$out/rviz_formation_turning.png" "$root/rviz/formation.rviz" \
           scenario:="$root/config/scenarios/figure_eight_2d.yaml" followers:=4 topology:=star \
           shape:=v slots:=turning ;;
-    path) shoot 13 "$out/rviz_formation_path.png" "$root/rviz/formation.rviz" \
+    path) shoot 13 "$out/rviz_formation_path.png" "$root/rviz/formation_path.rviz" \
           scenario:="$root/config/scenarios/figure_eight_2d.yaml" followers:=4 topology:=chain \
           shape:=line slots:=path ;;
     vehicles) launch=vehicles.launch
