@@ -9,7 +9,9 @@ its start: the adapter's cmd_vel reaches it), and no two robots of ~robots (defa
 robot_1) come closer than ~min_centre_distance m centre to centre (ground truth; two Thymios
 touch at about 0.11 m). With ~behind_leader (a turning leader and turning slots), each followed
 robot ends behind the leader's heading: in the leader's body frame (its ground-truth yaw), at
-least ~behind_margin m behind it.
+least ~behind_margin m behind it. With ~max_path_distance > 0 (a convoy, path slots), each followed
+robot's centre stays within it of the path the leader's centre drove (its ground truth, points
+5 mm apart) from ~path_after s after its first ground truth on.
 """
 
 import itertools
@@ -38,6 +40,10 @@ class EnkiPair(unittest.TestCase):
         self.start = {}
         self.min_distance = {pair: math.inf for pair in itertools.combinations(self.robots, 2)}
         self.travel = {robot: 0.0 for robot in self.robots}
+        self.path_after = float(rospy.get_param("~path_after", 20.0))
+        self.leader_path = []  # the leader's ground truth, points 5 mm apart
+        self.path_distance = {robot: 0.0 for robot in self.moving}
+        self.first_truth = None
         for name in self.followers:
             rospy.Subscriber(f"/{name}/status", FollowerStatus, self.on_status, name,
                              queue_size=100)
@@ -58,11 +64,26 @@ class EnkiPair(unittest.TestCase):
             self.yaw[robot] = math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
             sx, sy = self.start.setdefault(robot, (p.x, p.y))
             self.travel[robot] = max(self.travel[robot], math.hypot(p.x - sx, p.y - sy))
+            self.note_path(robot, p.x, p.y)
             for pair in self.min_distance:
                 if robot in pair and all(r in self.truth for r in pair):
                     (x0, y0), (x1, y1) = self.truth[pair[0]], self.truth[pair[1]]
                     self.min_distance[pair] = min(self.min_distance[pair],
                                                   math.hypot(x0 - x1, y0 - y1))
+
+    def note_path(self, robot, x, y):
+        """Records the leader's path; a followed robot's distance to it once ~path_after passed."""
+        now = time.monotonic()
+        if self.first_truth is None:
+            self.first_truth = now
+        if robot == self.robots[0]:
+            if not self.leader_path or math.hypot(x - self.leader_path[-1][0],
+                                                  y - self.leader_path[-1][1]) >= 0.005:
+                self.leader_path.append((x, y))
+        elif (robot in self.path_distance and self.leader_path
+              and now - self.first_truth >= self.path_after):
+            nearest = min(math.hypot(x - px, y - py) for px, py in self.leader_path)
+            self.path_distance[robot] = max(self.path_distance[robot], nearest)
 
     def wait_for(self, condition, deadline, what):
         end = time.monotonic() + deadline
@@ -94,6 +115,14 @@ class EnkiPair(unittest.TestCase):
             self.assertGreater(travel[robot], min_travel, f"{robot} did not move: no cmd_vel reached it")
         for pair, d in distance.items():
             self.assertGreater(d, min_centre, "%s and %s came too close" % pair)
+        max_path = float(rospy.get_param("~max_path_distance", 0.0))
+        if max_path > 0.0:
+            with self.lock:
+                path_distance = dict(self.path_distance)
+            print("enki: largest distance from the leader's path after %.0f s: %s m" % (
+                self.path_after, {r: round(d, 4) for r, d in path_distance.items()}), flush=True)
+            for robot, d in path_distance.items():
+                self.assertLessEqual(d, max_path, f"{robot} left the leader's path")
         if rospy.get_param("~behind_leader", False):
             margin = float(rospy.get_param("~behind_margin", 0.1))
             leader = self.robots[0]
