@@ -88,7 +88,7 @@ CASES = (
     Case("pair_stop_and_go", "turning_stop_and_go.yaml", _pair(),
          "stops, starts, turns, is pushed into reverse at 4 m/s"),
     Case("pair_figure_eight", "figure_eight_2d.yaml", _pair(),
-         "leader at 45 deg to d: the virtual road turns when the second point is recorded"),
+         "leader at 45 deg to d: the road stays along d, the path turns at its start"),
     Case("chain3_u_turn", "turning_u_turn.yaml", _chain(3), "chain of 3 on the U-turn"),
     Case("chain3_stop_and_go", "turning_stop_and_go.yaml", _chain(3),
          "chain of 3 on the stop-and-go"),
