@@ -22,7 +22,7 @@ FollowerConfiguration readConfiguration(const YAML::Node& root,
   FollowerConfiguration configuration;
   const AgentModel model = detail::readModel(reader);
   configuration.controller = detail::readController(reader, model);  // the link skipped
-  for (const char* simulation_section : {"leader", "follower", "simulation"}) {
+  for (const char* simulation_section : {"leader", "follower", "simulation", "world"}) {
     reader.skip(simulation_section);
   }
   configuration.formation = detail::readFormation(reader);

@@ -246,7 +246,12 @@ int runSimulation(const Scenario& scenario, const Options& options, std::ostream
   last << "formation followers=" << members.size()
        << " topology=" << toString(scenario.formation.topology)
        << " shape=" << toString(scenario.formation.shape)
-       << " min_pair_separation=" << summary.min_pair_separation << " wall_s=" << wall;
+       << " min_pair_separation=" << summary.min_pair_separation
+       << " perimeter=" << summary.perimeter
+       << " min_neighbour_separation=" << summary.min_neighbour_separation
+       << " pairs_inside_perimeter=" << summary.pairs_inside_perimeter
+       << " neighbour_pairs_inside_perimeter=" << summary.neighbour_pairs_inside_perimeter
+       << " wall_s=" << wall;
   out << last.str() << "\n";
   const StringStabilityFigures figures = stringStabilityFigures(summary);
   std::ostringstream string_line;

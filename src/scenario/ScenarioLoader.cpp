@@ -14,46 +14,12 @@
 
 #include "ConfigurationSections.hpp"
 #include "ControllerReader.hpp"
+#include "ScenarioSections.hpp"
 #include "YamlParser.hpp"
 #include "YamlReader.hpp"
 
 namespace projection_collision_avoidance {
 namespace {
-
-/// The pulses of the list @p name; each is checked against @p size entries, so that an error
-/// names the entry by its path in the file ("leader.disturbance.0.vector").
-std::vector<Pulse> readPulses(detail::YamlReader& parent, const std::string& name,
-                              Eigen::Index size) {
-  std::vector<Pulse> pulses;
-  const std::size_t count = parent.sequenceSize(name);
-  for (std::size_t i = 0; i < count; ++i) {
-    detail::YamlReader item = parent.item(name, i);
-    Pulse pulse;
-    pulse.start = item.number("start");
-    pulse.end = item.number("end");
-    pulse.vector = item.vector("vector");
-    item.finish();
-    if (!std::isfinite(pulse.start)) {
-      throw ParameterError(item.key("start"), "must be finite");
-    }
-    if (!std::isfinite(pulse.end)) {
-      throw ParameterError(item.key("end"), "must be finite");
-    }
-    if (!(pulse.start < pulse.end)) {
-      throw ParameterError(item.key("end"), "must be later than start");
-    }
-    if (pulse.vector.size() != size) {
-      throw ParameterError(item.key("vector"), "must have " + std::to_string(size) +
-                                                   " entries, got " +
-                                                   std::to_string(pulse.vector.size()));
-    }
-    if (!pulse.vector.allFinite()) {
-      throw ParameterError(item.key("vector"), "has a non-finite entry");
-    }
-    pulses.push_back(pulse);
-  }
-  return pulses;
-}
 
 SignalProfile readInputProfile(detail::YamlReader& leader, Eigen::Index size) {
   SignalProfile profile;
@@ -62,19 +28,10 @@ SignalProfile readInputProfile(detail::YamlReader& leader, Eigen::Index size) {
   }
   detail::YamlReader input = leader.map("input");
   if (input.has("pulses")) {
-    profile.pulses = readPulses(input, "pulses", size);
+    profile.pulses = detail::readPulses(input, "pulses", size);
   }
   if (input.has("sinusoids")) {
-    const std::size_t count = input.sequenceSize("sinusoids");
-    for (std::size_t i = 0; i < count; ++i) {
-      detail::YamlReader item = input.item("sinusoids", i);
-      Sinusoid wave;
-      wave.amplitude = item.vector("amplitude");
-      wave.frequency = item.number("frequency");
-      wave.phase = item.has("phase") ? item.number("phase") : 0.0;
-      item.finish();
-      profile.sinusoids.push_back(wave);
-    }
+    profile.sinusoids = detail::readSinusoids(input, "sinusoids");
   }
   input.finish();
   return profile;
@@ -119,7 +76,7 @@ Scenario readScenario(const YAML::Node& root, const ScenarioLoadOptions& options
   scenario.leader_initial_state = leader.vector("initial_state");
   scenario.leader_input = readInputProfile(leader, model.inputDimension());
   if (leader.has("disturbance")) {
-    scenario.disturbance.pulses = readPulses(leader, "disturbance", model.stateDimension());
+    scenario.disturbance.pulses = detail::readPulses(leader, "disturbance", model.stateDimension());
   }
   leader.finish();
 
@@ -132,6 +89,7 @@ Scenario readScenario(const YAML::Node& root, const ScenarioLoadOptions& options
   simulation.finish();
 
   scenario.formation = detail::readFormation(reader);
+  scenario.world = detail::readWorld(reader, model.stateDimension());
   reader.finish();
 
   scenario.validate();

@@ -19,6 +19,7 @@
 #include "projection_collision_avoidance/core/TurningSlot.hpp"
 #include "projection_collision_avoidance/sim/AgentIntegrator.hpp"
 #include "projection_collision_avoidance/sim/SharedLink.hpp"
+#include "projection_collision_avoidance/sim/VehicleResponse.hpp"
 
 namespace projection_collision_avoidance {
 namespace {
@@ -40,6 +41,52 @@ double positionDistance(const Vector& a, const Vector& b, int k) {
   return std::sqrt(squaredPositionDistance(a, b, k));
 }
 
+/// The smallest squared distance of every pair of agents (0 the leader, i follower i) and which
+/// pairs are neighbours (neither looks at the other).
+class PairMinima {
+ public:
+  explicit PairMinima(const std::vector<FormationMember>& members)
+      : agents_(members.size() + 1),
+        minima_(agents_ * (agents_ - 1) / 2, std::numeric_limits<double>::infinity()),
+        linked_(minima_.size(), false) {
+    for (const FormationMember& member : members) {
+      linked_[index(static_cast<std::size_t>(member.target),
+                    static_cast<std::size_t>(member.index))] = true;
+    }
+  }
+
+  /// The squared distance of agents a < b at a tick.
+  void observe(std::size_t a, std::size_t b, double squared) {
+    double& minimum = minima_[index(a, b)];
+    minimum = std::min(minimum, squared);
+  }
+
+  /// min_neighbour_separation and the pairs that came closer than @p perimeter (m).
+  void summarise(double perimeter, FormationSummary* summary) const {
+    double neighbours = std::numeric_limits<double>::infinity();
+    for (std::size_t p = 0; p < minima_.size(); ++p) {
+      const bool inside = minima_[p] < perimeter * perimeter;
+      summary->pairs_inside_perimeter += inside ? 1 : 0;
+      if (!linked_[p]) {
+        neighbours = std::min(neighbours, minima_[p]);
+        summary->neighbour_pairs_inside_perimeter += inside ? 1 : 0;
+      }
+    }
+    summary->perimeter = perimeter;
+    summary->min_neighbour_separation = std::sqrt(neighbours);
+  }
+
+ private:
+  /// Pair (a, b), a < b, in row order.
+  std::size_t index(std::size_t a, std::size_t b) const {
+    return a * agents_ - a * (a + 1) / 2 + (b - a - 1);
+  }
+
+  std::size_t agents_;
+  std::vector<double> minima_;
+  std::vector<bool> linked_;
+};
+
 /// One follower of the run: its controller, its plant and its figures.
 template <typename Dims>
 struct SimulatedFollower {
@@ -48,11 +95,13 @@ struct SimulatedFollower {
   /// state; null for other slots
   SimulatedFollower(const FormationMember& formation_member, const ControllerDesign& member_design,
                     const AgentModel& model, const SlotHeadingParameters* turning,
-                    const ConvoyParameters* path, const Eigen::VectorXd& target_state)
+                    const ConvoyParameters* path, const Eigen::VectorXd& target_state,
+                    const WorldSpec& world, double duration)
       : member(formation_member),
         design(member_design),
         controller(member_design),
-        plant(model, member_design.period, formation_member.initial_state),
+        plant(model, member_design.period, formation_member.initial_state,
+              world.disturbanceOf(formation_member.index, model, duration)),
         separation(formation_member.separation),
         command(Dims::InputVector::Zero(model.inputDimension())) {
     if (turning) {
@@ -68,6 +117,10 @@ struct SimulatedFollower {
       velocity.head(k) = target_state.segment(k, k);
       convoy->reset(position, velocity, formation_member.path_direction);
     }
+    const VehicleSpec& true_vehicle = world.vehicleOf(member.index);
+    if (world.configured && !true_vehicle.ideal()) {
+      vehicle.emplace(true_vehicle, member_design.period, model.inputDimension());
+    }
     summary.xi_max = design.xi_max;
     summary.perimeter = design.perimeter;
     summary.min_separation = std::numeric_limits<double>::infinity();
@@ -81,6 +134,7 @@ struct SimulatedFollower {
   typename Dims::InputVector command;     // u_i at the current tick
   std::optional<SlotHeading> heading;     // theta_i (T1) of a turning slot
   std::optional<ConvoyReference> convoy;  // r_i (C1)-(C3) of a path slot
+  std::optional<VehicleResponse<typename Dims::InputVector>> vehicle;  // a true vehicle apart
   SimulationSummary summary;
 };
 
@@ -112,7 +166,8 @@ FormationSummary runFormation(const Scenario& scenario, const ControllerDesign& 
                            : members[static_cast<std::size_t>(member.target - 1)].initial_state;
     followers.emplace_back(member, ControllerDesign::create(memberParameters(p, member)), model,
                            turning ? &scenario.formation.turning : nullptr,
-                           path ? &scenario.formation.path : nullptr, target_initial_state);
+                           path ? &scenario.formation.path : nullptr, target_initial_state,
+                           scenario.world, scenario.duration);
   }
   AgentIntegrator<Dims> leader(model, scenario_design.period, scenario.leader_initial_state,
                                scenario.disturbance);
@@ -125,8 +180,12 @@ FormationSummary runFormation(const Scenario& scenario, const ControllerDesign& 
   SharedLink<InputVector> link(scenario.link, p.control_rate, use_link ? n_agents : 0,
                                use_link ? n_agents : 0, InputVector::Zero(m));
 
+  const bool noisy = scenario.world.configured &&
+                     (scenario.world.noise_position > 0.0 || scenario.world.noise_velocity > 0.0);
   FormationSummary formation;
   double min_pair_squared = std::numeric_limits<double>::infinity();
+  // Per pair (a < b, agents 0 .. N), the smallest squared distance; and whether a looks at b.
+  PairMinima pairs(members);
   const long last_tick = std::lround(scenario.duration * p.control_rate);
   for (long tick = 0; tick <= last_tick; ++tick) {
     const double t = static_cast<double>(tick) / p.control_rate;
@@ -172,7 +231,14 @@ FormationSummary runFormation(const Scenario& scenario, const ControllerDesign& 
         convoySlotAcceleration(convoy, k, &slot_acceleration);  // u_r (C4)
       }
       const StateVector xi = target_state - follower.plant.state() - slot;
-      const OutputVector y = output_matrix * xi;
+      StateVector measured = xi;  // xi with the world's measurement noise
+      if (noisy) {
+        for (Eigen::Index e = 0; e < n; ++e) {
+          measured(e) += measurementNoise(scenario.world, follower.member.index, tick,
+                                          static_cast<int>(e), static_cast<int>(n), k);
+        }
+      }
+      const OutputVector y = output_matrix * measured;
       const StateVector& own_state = follower.plant.state();
       StepInputs<Dims> inputs{y, std::nullopt, own_state};
       if (share_leader_input) {
@@ -220,21 +286,25 @@ FormationSummary runFormation(const Scenario& scenario, const ControllerDesign& 
     // so the minimum is the same double.
     for (std::size_t a = 0; a < followers.size(); ++a) {
       const StateVector& x_a = followers[a].plant.state();
-      min_pair_squared =
-          std::min(min_pair_squared, squaredPositionDistance(x_a, leader.state(), k));
+      const double to_leader = squaredPositionDistance(x_a, leader.state(), k);
+      min_pair_squared = std::min(min_pair_squared, to_leader);
+      pairs.observe(0, a + 1, to_leader);
       for (std::size_t b = a + 1; b < followers.size(); ++b) {
-        min_pair_squared =
-            std::min(min_pair_squared, squaredPositionDistance(x_a, followers[b].plant.state(), k));
+        const double squared = squaredPositionDistance(x_a, followers[b].plant.state(), k);
+        min_pair_squared = std::min(min_pair_squared, squared);
+        pairs.observe(a + 1, b + 1, squared);
       }
     }
     if (tick < last_tick) {
       leader.advance(t, leader_input);
       for (SimulatedFollower<Dims>& follower : followers) {
-        follower.plant.advance(t, follower.command);
+        follower.plant.advance(
+            t, follower.vehicle ? follower.vehicle->apply(follower.command) : follower.command);
       }
     }
   }
   formation.min_pair_separation = std::sqrt(min_pair_squared);
+  pairs.summarise(scenario_design.perimeter, &formation);
   for (const SimulatedFollower<Dims>& follower : followers) {
     formation.followers.push_back(follower.summary);
     formation.targets.push_back(follower.member.target);

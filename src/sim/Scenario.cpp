@@ -28,6 +28,7 @@ void Scenario::validate() const {
   }
   formation.validate(model);
   formation.validateConvoy(controller);
+  world.validate(model, formation.followers, duration);
   if (link.configured) {
     link.validate(controller.control_rate);
     // A sender keeps D + 1 values in flight (SharedLink): bound the memory of the whole formation.

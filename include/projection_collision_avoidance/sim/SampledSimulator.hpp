@@ -53,6 +53,16 @@ struct FormationSummary {
   /// min ||p_a - p_b|| over every pair of agents, the leader included (m): pairs that are not
   /// leader and follower of each other are not protected by the method, only reported.
   double min_pair_separation = 0.0;
+  /// rho (m): every agent's perimeter for the pairs' figures, the paper's alpha ||d|| of the
+  /// scenario's d
+  double perimeter = 0.0;
+  /// min ||p_a - p_b|| over the pairs of which neither looks at the other (neighbours, m);
+  /// infinity when there is none
+  double min_neighbour_separation = 0.0;
+  /// The pairs of agents (any two) that came closer than rho at some tick.
+  int pairs_inside_perimeter = 0;
+  /// Of those, the pairs of which neither looks at the other.
+  int neighbour_pairs_inside_perimeter = 0;
 };
 
 /// Called once per control tick, in time order.

@@ -7,6 +7,7 @@
 #include "projection_collision_avoidance/core/Formation.hpp"
 #include "projection_collision_avoidance/sim/SharedLink.hpp"
 #include "projection_collision_avoidance/sim/SignalProfile.hpp"
+#include "projection_collision_avoidance/sim/WorldSpec.hpp"
 
 namespace projection_collision_avoidance {
 
@@ -24,11 +25,14 @@ struct Scenario {
   /// The link of the shared accelerations (controller.leader_information.link); a sampled run
   /// models it, the ROS nodes have a real one.
   LinkSpec link;
+  /// A world that can hurt the followers (section `world`): simulation only, ignored by the
+  /// nodes' controllers.
+  WorldSpec world;
 
   /// Checks the parts that ControllerDesign::create() does not: initial states, signals and
   /// duration, formation and link. Throws ParameterError naming "leader.*", "follower.*",
-  /// "simulation.duration", "formation.*" or "controller.leader_information.link[.*]" (a link
-  /// that carries nothing: neither command nor estimator shared).
+  /// "simulation.duration", "formation.*", "world.*" or "controller.leader_information.link[.*]" (a
+  /// link that carries nothing: neither command nor estimator shared).
   void validate() const;
 
   /// The followers' part of the scenario: the controller and the formation.
