@@ -5,6 +5,7 @@
 # projection_collision_avoidance_core: the controller, every law of the paper (Eigen and std only).
 set(PCA_CORE_SOURCES
   src/core/AgentModel.cpp
+  src/core/CommandProjection.cpp
   src/core/ControllerDesign.cpp
   src/core/ConvoyReference.cpp
   src/core/DynamicFollowerController.cpp
@@ -13,6 +14,7 @@ set(PCA_CORE_SOURCES
   src/core/FollowerMode.cpp
   src/core/Formation.cpp
   src/core/LinearAlgebra.cpp
+  src/core/NeighbourBarrier.cpp
   src/core/PlatoonLaws.cpp
   src/core/TargetPath.cpp
   src/core/TurningSlot.cpp
@@ -34,6 +36,7 @@ set(PCA_SIM_SOURCES
   src/sim/SimulationCsvWriter.cpp
   src/sim/StringStability.cpp
   src/sim/VehicleModels.cpp
+  src/sim/WorldSpec.cpp
 )
 
 # projection_collision_avoidance_configuration: a follower's configuration (the model, controller
@@ -51,6 +54,7 @@ set(PCA_CONFIGURATION_SOURCES
 set(PCA_SCENARIO_SOURCES
   src/scenario/CfSimApp.cpp
   src/scenario/ScenarioLoader.cpp
+  src/scenario/ScenarioSections.cpp
 )
 
 # projection_collision_avoidance_vehicle: the vehicle adapters' math (odometry pairs to a relative

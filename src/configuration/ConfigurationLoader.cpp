@@ -29,6 +29,7 @@ FollowerConfiguration readConfiguration(const YAML::Node& root,
   reader.finish();
 
   configuration.formation.validate(model);
+  configuration.formation.validateNeighbours(configuration.controller);
   if (options.check) {
     options.check(configuration);
   }

@@ -173,6 +173,20 @@ FormationSpec readFormation(YamlReader& reader) {
     }
     path.finish();
   }
+  if (formation.has("neighbours")) {
+    YamlReader section = formation.map("neighbours");
+    NeighbourParameters& neighbours = spec.neighbours;
+    neighbours.enabled = true;
+    readNumbers(section, {{"radius", &neighbours.radius},
+                          {"perimeter", &neighbours.perimeter},
+                          {"braking_acceleration", &neighbours.braking_acceleration},
+                          {"neighbour_acceleration", &neighbours.neighbour_acceleration},
+                          {"rate", &neighbours.rate}});
+    if (section.has("max_neighbours")) {
+      neighbours.max_neighbours = section.integer("max_neighbours");
+    }
+    section.finish();
+  }
   formation.finish();
   return spec;
 }

@@ -67,6 +67,7 @@ const DynamicFollowerStatus& DynamicFollowerController::step(const DynamicStepIn
     using C = std::decay_t<decltype(controller)>;
     StepInputs<typename C::Dimensions> converted;
     converted.period_fraction = inputs.period_fraction;
+    converted.command_constraints = inputs.command_constraints;
     if (inputs.measurement) {
       converted.measurement = as<typename C::OutputVector>(*inputs.measurement);
     }

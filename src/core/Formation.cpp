@@ -80,6 +80,18 @@ void FormationSpec::validateConvoy(const ControllerParameters& controller) const
   }
 }
 
+void FormationSpec::validateNeighbours(const ControllerParameters& controller) const {
+  if (!neighbours.enabled) {
+    return;
+  }
+  const int axes = controller.model.double_integrator_axes;
+  if (axes < 1 || axes > 3) {
+    throw ParameterError("formation.neighbours",
+                         "needs a double integrator of 1 to 3 axes (model.type, model.dimension)");
+  }
+  neighbours.validate(controller.acceleration_limit);
+}
+
 FormationMember formationSlot(const FormationSpec& spec, const Eigen::VectorXd& separation,
                               int index) {
   FormationMember member;

@@ -14,6 +14,7 @@
 #include "projection_collision_avoidance/core/ConvoyReference.hpp"
 #include "projection_collision_avoidance/core/DimensionDispatch.hpp"
 #include "projection_collision_avoidance/core/FollowerController.hpp"
+#include "projection_collision_avoidance/core/NeighbourBarrier.hpp"
 #include "projection_collision_avoidance/core/PaperLaws.hpp"
 #include "projection_collision_avoidance/core/ParameterError.hpp"
 #include "projection_collision_avoidance/core/TurningSlot.hpp"
@@ -96,7 +97,8 @@ struct SimulatedFollower {
   SimulatedFollower(const FormationMember& formation_member, const ControllerDesign& member_design,
                     const AgentModel& model, const SlotHeadingParameters* turning,
                     const ConvoyParameters* path, const Eigen::VectorXd& target_state,
-                    const WorldSpec& world, double duration)
+                    const WorldSpec& world, double duration, const NeighbourParameters* neighbours,
+                    double perimeter)
       : member(formation_member),
         design(member_design),
         controller(member_design),
@@ -117,6 +119,10 @@ struct SimulatedFollower {
       velocity.head(k) = target_state.segment(k, k);
       convoy->reset(position, velocity, formation_member.path_direction);
     }
+    if (neighbours) {
+      constraints.emplace(*neighbours, perimeter, model.position_dimension,
+                          member_design.parameters.acceleration_limit);
+    }
     const VehicleSpec& true_vehicle = world.vehicleOf(member.index);
     if (world.configured && !true_vehicle.ideal()) {
       vehicle.emplace(true_vehicle, member_design.period, model.inputDimension());
@@ -135,8 +141,36 @@ struct SimulatedFollower {
   std::optional<SlotHeading> heading;     // theta_i (T1) of a turning slot
   std::optional<ConvoyReference> convoy;  // r_i (C1)-(C3) of a path slot
   std::optional<VehicleResponse<typename Dims::InputVector>> vehicle;  // a true vehicle apart
+  std::optional<NeighbourConstraints> constraints;  // (N3) with formation.neighbours
   SimulationSummary summary;
 };
+
+/// (N3): follower @p self's sensed agents this tick, every agent but itself (the leader's state
+/// @p leader, the followers' plants), exact relative states; its target with the perimeter of its
+/// design, alpha ||d_i||.
+template <typename Dims>
+void senseNeighbours(SimulatedFollower<Dims>& self, const typename Dims::StateVector& leader,
+                     const std::vector<SimulatedFollower<Dims>>& followers, int k) {
+  NeighbourConstraints& constraints = *self.constraints;
+  constraints.clear();
+  const auto& own = self.plant.state();
+  auto add = [&](const typename Dims::StateVector& other, int index) {
+    Eigen::Vector3d p = Eigen::Vector3d::Zero();
+    Eigen::Vector3d v = Eigen::Vector3d::Zero();
+    for (int e = 0; e < k; ++e) {
+      p(e) = own(e) - other(e);
+      v(e) = own(k + e) - other(k + e);
+    }
+    constraints.add(p, v,
+                    index == self.member.target ? self.design.perimeter : constraints.perimeter());
+  };
+  add(leader, 0);
+  for (const SimulatedFollower<Dims>& other : followers) {
+    if (other.member.index != self.member.index) {
+      add(other.plant.state(), other.member.index);
+    }
+  }
+}
 
 template <typename Dims>
 FormationSummary runFormation(const Scenario& scenario, const ControllerDesign& scenario_design,
@@ -160,14 +194,19 @@ FormationSummary runFormation(const Scenario& scenario, const ControllerDesign& 
   const int n_agents = static_cast<int>(members.size()) + 1;
   std::vector<SimulatedFollower<Dims>> followers;
   followers.reserve(members.size());
+  const double neighbour_perimeter = std::isnan(scenario.formation.neighbours.perimeter)
+                                         ? scenario_design.perimeter
+                                         : scenario.formation.neighbours.perimeter;
   for (const FormationMember& member : members) {
     const Eigen::VectorXd& target_initial_state =
         member.target == 0 ? scenario.leader_initial_state
                            : members[static_cast<std::size_t>(member.target - 1)].initial_state;
-    followers.emplace_back(member, ControllerDesign::create(memberParameters(p, member)), model,
-                           turning ? &scenario.formation.turning : nullptr,
-                           path ? &scenario.formation.path : nullptr, target_initial_state,
-                           scenario.world, scenario.duration);
+    followers.emplace_back(
+        member, ControllerDesign::create(memberParameters(p, member)), model,
+        turning ? &scenario.formation.turning : nullptr, path ? &scenario.formation.path : nullptr,
+        target_initial_state, scenario.world, scenario.duration,
+        scenario.formation.neighbours.enabled ? &scenario.formation.neighbours : nullptr,
+        neighbour_perimeter);
   }
   AgentIntegrator<Dims> leader(model, scenario_design.period, scenario.leader_initial_state,
                                scenario.disturbance);
@@ -246,6 +285,10 @@ FormationSummary runFormation(const Scenario& scenario, const ControllerDesign& 
       }
       if (follower.heading || follower.convoy) {
         inputs.slot_acceleration = slot_acceleration;
+      }
+      if (follower.constraints) {
+        senseNeighbours(follower, leader.state(), followers, k);
+        inputs.command_constraints = &follower.constraints->projection();
       }
       const auto& status = follower.controller.step(inputs);
       follower.command = status.command;

@@ -28,6 +28,7 @@ void Scenario::validate() const {
   }
   formation.validate(model);
   formation.validateConvoy(controller);
+  formation.validateNeighbours(controller);
   world.validate(model, formation.followers, duration);
   if (link.configured) {
     link.validate(controller.control_rate);

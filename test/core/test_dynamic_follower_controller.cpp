@@ -34,7 +34,8 @@ void expectSameStatus(const FollowerControllerStatus<DimsA>& a,
                fallback_command, slot_command, estimate, estimate_norm, constraint_value,
                command_saturated, command_rate_limited, fallback, projection_active,
                boundary_correction, measurement_rejected, leader_input_rejected,
-               slot_acceleration_rejected, command_overflow, estimate_held] = a;
+               slot_acceleration_rejected, command_overflow, estimate_held, command_projected,
+               constraints_given, constraints_active, constraints_dropped] = a;
   EXPECT_MATRIX_NEAR(command, b.command, tolerance);
   EXPECT_MATRIX_NEAR(baseline_command, b.baseline_command, tolerance);
   EXPECT_MATRIX_NEAR(tracker_command, b.tracker_command, tolerance);
@@ -55,6 +56,10 @@ void expectSameStatus(const FollowerControllerStatus<DimsA>& a,
   EXPECT_EQ(slot_acceleration_rejected, b.slot_acceleration_rejected);
   EXPECT_EQ(command_overflow, b.command_overflow);
   EXPECT_EQ(estimate_held, b.estimate_held);
+  EXPECT_EQ(command_projected, b.command_projected);
+  EXPECT_EQ(constraints_given, b.constraints_given);
+  EXPECT_EQ(constraints_active, b.constraints_active);
+  EXPECT_EQ(constraints_dropped, b.constraints_dropped);
 }
 
 TEST(DynamicFollowerController, MatchesTheFixedSizeController) {

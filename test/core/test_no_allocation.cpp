@@ -8,10 +8,12 @@
 #include <Eigen/Core>
 #include <gtest/gtest.h>
 
+#include "projection_collision_avoidance/core/CommandProjection.hpp"
 #include "projection_collision_avoidance/core/ControllerDesign.hpp"
 #include "projection_collision_avoidance/core/ConvoyReference.hpp"
 #include "projection_collision_avoidance/core/DynamicFollowerController.hpp"
 #include "projection_collision_avoidance/core/FollowerController.hpp"
+#include "projection_collision_avoidance/core/NeighbourBarrier.hpp"
 #include "projection_collision_avoidance/sim/AgentIntegrator.hpp"
 #include "projection_collision_avoidance/sim/ContinuousDynamics.hpp"
 #include "projection_collision_avoidance/sim/SampledSimulator.hpp"
@@ -290,6 +292,64 @@ TEST(NoAllocation, CommandConversions) {
     EXPECT_EQ(testing::allocationCount() - before, 0) << unicycle;
     EXPECT_GT(converter.response().observations, 50U);
   }
+}
+
+/// The command projection (ball and half-spaces) allocates nothing per projection: full
+/// problems in 1, 2 and 3 dimensions, feasible and infeasible (the fallback drops half-spaces).
+TEST(NoAllocation, CommandProjections) {
+  for (const int m : {1, 2, 3}) {
+    CommandProjection projection(m);
+    for (int j = 0; j < CommandProjection::kMaxConstraints; ++j) {
+      const double angle = 0.7 * j;
+      projection.add(Eigen::Vector3d(std::cos(angle), std::sin(angle), std::cos(1.3 * j)),
+                     j % 7 == 6 ? 1.5 : -0.2);  // every 7th misses the ball of radius 1
+    }
+    int dropped = 0;
+    int changed = 0;
+    const long before = testing::allocationCount();
+    for (int k = 0; k < 200; ++k) {
+      const Eigen::Vector3d nominal(0.03 * k - 3.0, std::sin(0.1 * k), 0.5);
+      const CommandProjectionResult r = projection.project(nominal, k % 3 == 0 ? 1.0 : 2.0);
+      dropped += r.dropped;
+      changed += r.changed ? 1 : 0;
+    }
+    EXPECT_EQ(testing::allocationCount() - before, 0) << m;
+    EXPECT_GT(dropped, 0) << m;
+    EXPECT_GT(changed, 0) << m;
+  }
+}
+
+/// The neighbours' half-spaces (N3) and a controller step projected onto them allocate nothing:
+/// more neighbours than kept, some inside the perimeter, with and without a measurement.
+TEST(NoAllocation, NeighbourConstraintsAndAProjectedStep) {
+  NeighbourParameters parameters;
+  parameters.enabled = true;
+  parameters.braking_acceleration = 1.0;
+  parameters.neighbour_acceleration = 1.0;
+  parameters.max_neighbours = 6;
+  const Scenario scenario = loadScenarioFile(testing::scenarioPath("crowd_v4_gust.yaml"),
+                                             {"controller.acceleration_limit=3"});
+  DynamicFollowerController controller(ControllerDesign::create(scenario.controller));
+  NeighbourConstraints constraints(parameters, 1.0, 2, 3.0);
+  const Eigen::VectorXd y = Eigen::Vector4d(0.3, -0.2, 0.1, 0.4);
+  int projected = 0;
+  const long before = testing::allocationCount();
+  for (int k = 0; k < 300; ++k) {
+    constraints.clear();
+    for (int j = 0; j < 12; ++j) {
+      const double angle = 0.5 * j + 0.01 * k;
+      const Eigen::Vector3d position(std::cos(angle) * (0.5 + 0.4 * j), std::sin(angle), 0.0);
+      constraints.add(position, Eigen::Vector3d(-position.x(), 0.3, 0.0), 1.0 + 0.1 * (j % 2));
+    }
+    DynamicStepInputs inputs;
+    if (k % 5 != 4) {
+      inputs.measurement.emplace(y);
+    }
+    inputs.command_constraints = &constraints.projection();
+    projected += controller.step(inputs).command_projected ? 1 : 0;
+  }
+  EXPECT_EQ(testing::allocationCount() - before, 0);
+  EXPECT_GT(projected, 0);
 }
 
 /// The sampled closed loop allocates while it sets up and nothing per tick: a run twice as long

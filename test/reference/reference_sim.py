@@ -64,14 +64,59 @@ takes psi' as a difference quotient, this is exact in time: the two agree to O(T
 
 Formations: a ``formation`` section (keys as cf_sim's) is covered when every follower
 looks at the leader, i.e. ``followers: 1`` (either topology) or ``topology: star``; a
-chain of more followers is refused (exit 2). Follower i runs the pair's loop on its own
-d_i (doc/formations.md: line i d; V ceil(i/2) R(+-half_angle) d, + for odd i), with its
+chain of more followers is refused (exit 2) but by the sampled loop (below). Follower i
+runs the pair's loop on its own d_i (doc/formations.md: line i d; V ceil(i/2) R(+-half_angle) d, + for odd i), with its
 own xi_max, and starts with the scenario's xi_0; the followers do not interact, so each
 is simulated alone. The output is then cf_sim's: a line
 ``follower_<i> target=leader max_xi=..`` per follower, then
 ``formation followers=.. topology=.. shape=.. slots=.. min_pair_separation=.. wall_s=..``
 (the smallest distance between any two agents, leader included, on the grid); --csv FILE
 writes FILE with _follower_<i> before its extension, per follower.
+
+The formation line also gives ``perimeter=`` (alpha ||d|| of the scenario's d),
+``min_neighbour_separation=`` (over the pairs of which neither looks at the other),
+``pairs_inside_perimeter=`` and ``neighbour_pairs_inside_perimeter=`` (the pairs whose smallest
+distance on the grid is below the perimeter), as cf_sim's does.
+
+World and neighbours: the sampled loop. The section ``world`` (doc/formations.md, "A world that
+can hurt") and ``formation.neighbours`` ((N1)-(N3) of doc/formations.md, "Neighbours") act per
+control tick, so a scenario with either (or any scenario with --sampled) is not integrated in
+continuous time but run as the sampled recursion of doc/math.md ("Follower command",
+"Discretisation", "Offline simulator (cf_sim)"), every agent together (a star or a chain of
+world slots; turning slots are refused). At tick t_k = k T, T = 1 / control_rate, with every
+agent's true state x_j(t_k) and follower i looking at agent t(i) (0 the leader)::
+
+    xi_i   = x_t(i) - x_i - d_i,   y = C (xi_i + noise_k)        noise entry e: sigma_e
+             N(seed, 4 i + 1, k n + e) (sigma: position on the k position entries, else velocity)
+    xi_hat = pinv(C) y moved into ||.|| <= xi_max at k = 0 (or 0: initial_estimate: zero)
+    u      = sat(G y + u_a + u_ff, controller.acceleration_limit), u_a as above (0 tracker off)
+    u      = u_prev + clamp(u - u_prev, jerk_limit T)            (controller.jerk_limit)
+    u      = the projection (N3) of u (formation.neighbours), below
+    xi_hat over [t_k, t_k+1]: `substeps` RK4 steps of the projected drift above with y, w and
+           the augmentation held (u_a, or u - G y - u_ff where saturation, the rate limit or the
+           projection changed the command), after each step moved back into ||.|| <= xi_max
+    s_k    = sat(u, a_max of the vehicle);  z_k = z_k-1 + (1 - exp(-T / tau)) (s_k - z_k-1)
+             (z_k = s_k for tau = 0, z_-1 = 0);  the plant is driven by g z_k over [t_k, t_k+1)
+    plants exactly over [t_k, t_k+1] (x(t + h) = Phi(h) x + Psi(h) v, v constant), the period
+           cut at the agent's own pulse edges: the leader's u_1(t_k) held and its disturbance
+           pulses; follower i's pulses (world.followers and its gusts) and its sinusoids, these
+           taken at the middle of each piece
+
+u_prev is the command of the tick before (0 before the first). Gusts of follower i are drawn
+from stream 4 i in the order of doc/formations.md (gust_pulses()); U and N as there
+(uniform_draw(), normal_draws()). The summary figures use the true xi_i.
+
+(N1)-(N3): follower i senses every other agent j within `radius` (its own target included, with
+rho_j = alpha ||d_i||, every other with rho = perimeter); with p = p_i - p_j, v = v_i - v_j,
+c = ||p||, n = p / c (the x axis at c = 0), s = -n.v and v_perp^2 = max(0, ||v||^2 - (n.v)^2):
+beyond rho_j h = sqrt(2 a_b (c - rho_j)) - s and b = a_b s / sqrt(2 a_b (c - rho_j)) - v_perp^2 / c
++ A_n - omega h, else h = -inf and b = a_b + A_n. The half-space n.u >= b is dropped where b is
+not finite or b <= -a_max (a_max = controller.acceleration_limit), and of the rest the
+max_neighbours most urgent are kept (smaller h first, ties by smaller c). u is replaced by its
+Euclidean projection onto the ball ||u|| <= a_max and the kept half-spaces, computed exactly by
+enumerating active sets (nearest_point()); if that set is empty, the half-spaces are added in
+priority order and any whose addition empties it is dropped (project_command()). Its CSV adds
+u_applied_* (g z), noise_*, and per tick saturated, rate_limited, projected, kept, dropped.
 
 The input and disturbance pulses make the right-hand side discontinuous in time,
 so the integration is restarted at every pulse edge. Inside a segment the
@@ -93,7 +138,10 @@ u_slot_* (u_r).
 Usage::
 
     reference_sim.py SCENARIO.yaml [--set key=value]... [--method LSODA]
-                     [--rtol 1e-6] [--atol 1e-9] [--max-step S] [--csv FILE]
+                     [--rtol 1e-6] [--atol 1e-9] [--max-step S] [--csv FILE] [--sampled]
+
+(--method, --rtol, --atol and --max-step are the continuous loop's; the sampled loop has none.)
+controller.acceleration_limit and controller.jerk_limit are accepted by the sampled loop only.
 
 Exit codes: 0 success, 1 integration failure, 2 bad command line or scenario.
 """
@@ -102,6 +150,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import itertools
 import math
 import os
 import sys
@@ -112,7 +161,7 @@ from types import SimpleNamespace
 import numpy as np
 import yaml
 from scipy.integrate import solve_ivp
-from scipy.linalg import solve_continuous_lyapunov
+from scipy.linalg import expm, solve_continuous_lyapunov
 
 PROG = "reference_sim"
 
@@ -131,6 +180,7 @@ class ScenarioError(Exception):
 _PULSE = {"start": None, "end": None, "vector": None}
 _SINUSOID = {"amplitude": None, "frequency": None, "phase": None}
 _GAIN = {"gain": None, "natural_frequency": None, "damping": None}
+_VEHICLE = {"acceleration_limit": None, "input_gain": None, "actuator_lag": None}
 SCHEMA = {
     "model": {
         "type": None,
@@ -154,6 +204,8 @@ SCHEMA = {
         },
         "tracker": {"enabled": None, "reference_gain": None, **_GAIN},
         "leader_information": {"command": None, "estimator": None, "disturbance": None},
+        "acceleration_limit": None,     # sampled loop only (world, neighbours, --sampled)
+        "jerk_limit": None,             # sampled loop only
     },
     "leader": {
         "initial_state": None,
@@ -162,6 +214,15 @@ SCHEMA = {
     },
     "follower": {"initial_state": None},
     "simulation": {"duration": None},
+    "world": {
+        "seed": None,
+        "vehicle": dict(_VEHICLE),
+        "followers": [{"index": None, "disturbance": [_PULSE], "sinusoids": [_SINUSOID],
+                       "vehicle": dict(_VEHICLE)}],
+        "gusts": {"rate": None, "magnitude": None, "min_duration": None, "max_duration": None,
+                  "start": None, "end": None},
+        "measurement_noise": {"position": None, "velocity": None},
+    },
     "formation": {
         "followers": None,
         "topology": None,
@@ -175,6 +236,14 @@ SCHEMA = {
             "max_yaw_acceleration": None,
             "min_speed": None,
             "reversing": None,
+        },
+        "neighbours": {
+            "radius": None,
+            "perimeter": None,
+            "braking_acceleration": None,
+            "neighbour_acceleration": None,
+            "rate": None,
+            "max_neighbours": None,
         },
     },
 }
@@ -353,6 +422,11 @@ class Scenario:
     disturbances: list = field(default_factory=list)   # (start, end, n-vector)
     duration: float = 0.0
     formation: Formation = None     # None: the pair, no formation section
+    acceleration_limit: float = math.inf   # controller.acceleration_limit (sampled loop)
+    jerk_limit: float = math.inf           # controller.jerk_limit (sampled loop)
+    world: World = None             # the section world (sampled loop); None without it
+    substeps: int = 1               # controller.estimator.substeps (sampled loop)
+    sampled: bool = False           # run the sampled loop (world, neighbours or --sampled)
 
     def __post_init__(self):
         self.n, self.m = self.B.shape
@@ -438,8 +512,21 @@ class Turning:
 
 
 @dataclass(frozen=True)
+class Neighbours:
+    """formation.neighbours: the command projection (N1)-(N3) (sampled loop only)."""
+
+    radius: float = math.inf            # m: farther agents are not sensed
+    perimeter: float = math.nan         # rho (m); nan: alpha ||d|| of the scenario's d
+    braking_acceleration: float = 1.0   # a_b (m/s^2), > 0
+    neighbour_acceleration: float = 0.0  # A_n (m/s^2), >= 0
+    rate: float = 2.0                   # omega (1/s), > 0
+    max_neighbours: int = 8             # the most urgent half-spaces kept, 1 .. 32
+
+
+@dataclass(frozen=True)
 class Formation:
-    """The scenario's formation section: followers that all look at the leader."""
+    """The scenario's formation section: followers that all look at the leader (the continuous
+    loop), or a star or chain of world slots (the sampled loop)."""
 
     followers: int = 1
     topology: str = "star"
@@ -447,14 +534,17 @@ class Formation:
     half_angle: float = math.pi / 6.0   # rad, each arm of a V to d
     slots: str = "world"                # world | turning
     turning: Turning = field(default_factory=Turning)
+    neighbours: Neighbours = None       # formation.neighbours; None without it
 
 
-def parse_formation(node, double_integrator, k):
+def parse_formation(node, double_integrator, k, sampled=False):
     """The formation section, or None without one.
 
     Covered: a star (every follower looks at the leader, so that each runs the
     pair's loop on its own d_i and is simulated alone) and the single follower of
-    either topology. A chain of more than one follower is refused.
+    either topology. A chain of more than one follower is refused, unless the loop is
+    the sampled one (sampled: a world or neighbours section, or --sampled), which simulates
+    every agent together.
     """
     if node is None:
         return None
@@ -466,7 +556,7 @@ def parse_formation(node, double_integrator, k):
     topology = node.get("topology", "star")
     if topology not in ("star", "chain"):
         raise ScenarioError(f"formation.topology: expected star or chain, got {topology!r}")
-    if topology == "chain" and followers > 1:
+    if topology == "chain" and followers > 1 and not sampled:
         raise ScenarioError(
             f"formation.topology = chain with {followers} followers: not covered by the "
             "reference, which simulates followers that look at the leader (a star, or "
@@ -504,8 +594,178 @@ def parse_formation(node, double_integrator, k):
         if key != "min_speed" and not value > 0.0:
             raise ScenarioError(f"formation.turning.{key}: must be > 0")
         values[key] = value
+    neighbours = parse_neighbours(node.get("neighbours"), "neighbours" in node,
+                                  double_integrator, k)
     return Formation(followers=followers, topology=topology, shape=shape,
-                     half_angle=half_angle, slots=slots, turning=Turning(**values))
+                     half_angle=half_angle, slots=slots, turning=Turning(**values),
+                     neighbours=neighbours)
+
+
+def as_limit(v, path):
+    """A number > 0 or .inf (a limit that may be absent)."""
+    if not _is_number(v) or math.isnan(float(v)) or not float(v) > 0.0:
+        raise ScenarioError(f"{path}: expected a number > 0 or .inf, got {v!r}")
+    return float(v)
+
+
+def parse_neighbours(node, given, double_integrator, k):
+    """formation.neighbours (N1)-(N3), or None without it. The perimeter's default, alpha ||d||
+    of the scenario's d, is filled in by build_scenario()."""
+    if not given:
+        return None
+    node = node or {}
+    if not isinstance(node, dict):
+        raise ScenarioError("formation.neighbours: expected a mapping")
+    if not (double_integrator and 1 <= k <= 3):
+        raise ScenarioError("formation.neighbours: needs a double_integrator model of 1 to 3 axes")
+    path = "formation.neighbours"
+    radius = node.get("radius", math.inf)
+    if not _is_number(radius) or math.isnan(float(radius)) or not float(radius) >= 0.0:
+        raise ScenarioError(f"{path}.radius: expected a number >= 0 or .inf")
+    values = {"radius": float(radius)}
+    if node.get("perimeter") is not None:
+        values["perimeter"] = as_float(node["perimeter"], f"{path}.perimeter")
+        if not values["perimeter"] >= 0.0:
+            raise ScenarioError(f"{path}.perimeter: must be >= 0")
+    for key, low, strict in (("braking_acceleration", 0.0, True),
+                             ("neighbour_acceleration", 0.0, False), ("rate", 0.0, True)):
+        if node.get(key) is not None:
+            value = as_float(node[key], f"{path}.{key}")
+            if not (value > low if strict else value >= low):
+                raise ScenarioError(f"{path}.{key}: must be {'>' if strict else '>='} {low:g}")
+            values[key] = value
+    if node.get("max_neighbours") is not None:
+        count = node["max_neighbours"]
+        if isinstance(count, bool) or not isinstance(count, int) or not 1 <= count <= 32:
+            raise ScenarioError(f"{path}.max_neighbours: expected an integer in 1 .. 32")
+        values["max_neighbours"] = count
+    return Neighbours(**values)
+
+
+@dataclass(frozen=True)
+class Vehicle:
+    """A follower's true vehicle (world.vehicle): s = sat(u, acceleration_limit), a first-order
+    lag of actuator_lag s sampled at the control period, driven with input_gain * z."""
+
+    acceleration_limit: float = math.inf
+    input_gain: float = 1.0
+    actuator_lag: float = 0.0
+
+
+@dataclass(frozen=True)
+class Gusts:
+    """world.gusts: a Poisson process of rate per follower over [start, end)."""
+
+    rate: float = 0.0
+    magnitude: float = 0.0
+    min_duration: float = 0.5
+    max_duration: float = 2.0
+    start: float = 0.0
+    end: float = math.inf
+
+
+@dataclass(frozen=True)
+class FollowerWorld:
+    """world.followers.<j>: what differs for follower `index`."""
+
+    index: int
+    disturbances: list          # (start, end, n-vector), pulses on the state derivative
+    sinusoids: list             # (n-vector amplitude, frequency, phase)
+    vehicle: Vehicle
+
+
+@dataclass(frozen=True)
+class World:
+    """The section world (sampled loop only)."""
+
+    seed: int = 0
+    vehicle: Vehicle = field(default_factory=Vehicle)
+    followers: dict = field(default_factory=dict)     # index -> FollowerWorld
+    gusts: Gusts = field(default_factory=Gusts)
+    noise_position: float = 0.0
+    noise_velocity: float = 0.0
+
+
+def _mapping(node, path):
+    if node is None:
+        return {}
+    if not isinstance(node, dict):
+        raise ScenarioError(f"{path}: expected a mapping")
+    return node
+
+
+def _vehicle(node, path, base):
+    node = _mapping(node, path)
+    limit = as_limit(node.get("acceleration_limit", base.acceleration_limit),
+                     f"{path}.acceleration_limit")
+    gain = as_float(node.get("input_gain", base.input_gain), f"{path}.input_gain")
+    if not gain > 0.0:
+        raise ScenarioError(f"{path}.input_gain: must be > 0")
+    lag = as_float(node.get("actuator_lag", base.actuator_lag), f"{path}.actuator_lag")
+    if not lag >= 0.0:
+        raise ScenarioError(f"{path}.actuator_lag: must be >= 0")
+    return Vehicle(acceleration_limit=limit, input_gain=gain, actuator_lag=lag)
+
+
+def parse_world(node, n, followers):
+    """The section world, or None without it (followers: how many the run has)."""
+    node = _mapping(node, "world")
+    seed = node.get("seed", 0)
+    if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2 ** 64:
+        raise ScenarioError(f"world.seed: expected a whole number >= 0, got {seed!r}")
+    vehicle = _vehicle(node.get("vehicle"), "world.vehicle", Vehicle())
+    items = node.get("followers") or []
+    if not isinstance(items, list):
+        raise ScenarioError("world.followers: expected a list")
+    per = {}
+    for j, item in enumerate(items):
+        path = f"world.followers.{j}"
+        item = _mapping(item, path)
+        index = get(item, "index", path)
+        if isinstance(index, bool) or not isinstance(index, int) or not 1 <= index <= followers:
+            raise ScenarioError(f"{path}.index: expected an integer in 1 .. {followers}")
+        if index in per:
+            raise ScenarioError(f"{path}.index: follower {index} is given twice")
+        sins = []
+        raw_sins = item.get("sinusoids") or []
+        if not isinstance(raw_sins, list):
+            raise ScenarioError(f"{path}.sinusoids: expected a list")
+        for q, sn in enumerate(raw_sins):
+            spath = f"{path}.sinusoids.{q}"
+            sn = _mapping(sn, spath)
+            sins.append((as_vector(get(sn, "amplitude", spath), f"{spath}.amplitude", n),
+                         as_float(get(sn, "frequency", spath), f"{spath}.frequency"),
+                         as_float(sn.get("phase", 0.0), f"{spath}.phase")))
+        per[index] = FollowerWorld(
+            index=index, disturbances=_pulses(item.get("disturbance"), f"{path}.disturbance", n),
+            sinusoids=sins, vehicle=_vehicle(item.get("vehicle"), f"{path}.vehicle", vehicle))
+    gnode = _mapping(node.get("gusts"), "world.gusts")
+    g = {}
+    for key, default in vars(Gusts()).items():
+        value = gnode.get(key, default)
+        if key == "end":
+            if not _is_number(value) or math.isnan(float(value)):
+                raise ScenarioError("world.gusts.end: expected a number or .inf")
+            g[key] = float(value)
+        else:
+            g[key] = as_float(value, f"world.gusts.{key}")
+    gusts = Gusts(**g)
+    if not (gusts.rate >= 0.0 and gusts.magnitude >= 0.0):
+        raise ScenarioError("world.gusts: rate and magnitude must be >= 0")
+    if not gusts.min_duration > 0.0:
+        raise ScenarioError("world.gusts.min_duration: must be > 0")
+    if not gusts.max_duration >= gusts.min_duration:
+        raise ScenarioError("world.gusts.max_duration: must be >= min_duration")
+    if not gusts.end > gusts.start:
+        raise ScenarioError("world.gusts.end: must be > start")
+    noise = _mapping(node.get("measurement_noise"), "world.measurement_noise")
+    sigma = {}
+    for key in ("position", "velocity"):
+        sigma[key] = as_float(noise.get(key, 0.0), f"world.measurement_noise.{key}")
+        if not sigma[key] >= 0.0:
+            raise ScenarioError(f"world.measurement_noise.{key}: must be >= 0")
+    return World(seed=seed, vehicle=vehicle, followers=per, gusts=gusts,
+                 noise_position=sigma["position"], noise_velocity=sigma["velocity"])
 
 
 def slot_layout(formation, d, k):
@@ -536,11 +796,19 @@ def rotate_z(p, angle):
     return out
 
 
-def build_scenario(raw):
-    """Validate the raw YAML tree and return a Scenario."""
+def build_scenario(raw, sampled=False):
+    """Validate the raw YAML tree and return a Scenario.
+
+    The loop is the sampled one (Scenario.sampled) with sampled set (--sampled), a section
+    world or formation.neighbours; else the continuous one, which refuses
+    controller.acceleration_limit and controller.jerk_limit (defined per control period here).
+    """
     if not isinstance(raw, dict):
         raise ScenarioError("the scenario must be a YAML mapping")
     check_keys(raw, SCHEMA)
+    fnode = raw.get("formation")
+    sampled = bool(sampled or "world" in raw
+                   or (isinstance(fnode, dict) and "neighbours" in fnode))
 
     model = get(raw, "model", "")
     mtype = get(model, "type", "model")
@@ -639,6 +907,16 @@ def build_scenario(raw):
                              "controller.leader_information.estimator")
     info_disturbance = as_bool(info.get("disturbance", False),
                                "controller.leader_information.disturbance")
+    limits = {}
+    for key in ("acceleration_limit", "jerk_limit"):
+        if ctl.get(key) is None:
+            limits[key] = math.inf
+            continue
+        limits[key] = as_limit(ctl[key], f"controller.{key}")
+        if not sampled and limits[key] < math.inf:
+            raise ScenarioError(
+                f"controller.{key}: covered by the sampled loop only (a section world or "
+                "formation.neighbours, or --sampled)")
 
     leader = get(raw, "leader", "")
     x1_0 = as_vector(get(leader, "initial_state", "leader"), "leader.initial_state", n)
@@ -666,7 +944,22 @@ def build_scenario(raw):
     if not duration > 0:
         raise ScenarioError("simulation.duration: must be > 0")
 
-    formation = parse_formation(raw.get("formation"), double_integrator, k)
+    formation = parse_formation(raw.get("formation"), double_integrator, k, sampled)
+    if formation is not None and formation.neighbours is not None \
+            and math.isnan(formation.neighbours.perimeter):
+        formation = dataclasses.replace(formation, neighbours=dataclasses.replace(
+            formation.neighbours, perimeter=alpha * float(np.linalg.norm(d))))
+    if sampled and formation is not None and formation.slots != "world":
+        raise ScenarioError(
+            f"formation.slots = {formation.slots}: the sampled loop (world, neighbours) covers "
+            "world slots only")
+    if sampled and formation is not None and formation.topology == "chain" \
+            and formation.followers > 1 and (info_command or info_estimator):
+        raise ScenarioError(
+            "controller.leader_information: not covered by the reference for a chain (a "
+            "follower's target is then a follower, whose command it is not told)")
+    world = parse_world(raw.get("world"), n, formation.followers if formation else 1) \
+        if "world" in raw else None
 
     return Scenario(A=A, B=B, C=C, k=k, double_integrator=double_integrator,
                     control_rate=control_rate, d=d, alpha=alpha, epsilon=epsilon,
@@ -674,10 +967,13 @@ def build_scenario(raw):
                     info_command=info_command, info_estimator=info_estimator,
                     info_disturbance=info_disturbance,
                     x1_0=x1_0, x2_0=x2_0, input_pulses=input_pulses, sinusoids=sinusoids,
-                    disturbances=disturbances, duration=duration, formation=formation)
+                    disturbances=disturbances, duration=duration, formation=formation,
+                    acceleration_limit=limits["acceleration_limit"],
+                    jerk_limit=limits["jerk_limit"], world=world, substeps=substeps or 1,
+                    sampled=sampled)
 
 
-def load_scenario(path, overrides=()):
+def load_scenario(path, overrides=(), sampled=False):
     """Read a scenario file, apply the --set overrides, validate it."""
     try:
         with open(path, encoding="utf-8") as fh:
@@ -692,7 +988,7 @@ def load_scenario(path, overrides=()):
         if not isinstance(raw, dict):
             break
         apply_override(raw, assignment)
-    return build_scenario(raw)
+    return build_scenario(raw, sampled)
 
 
 # --------------------------------------------------------------------------
@@ -1062,6 +1358,579 @@ def summary(sc, cols, wall):
 
 
 # --------------------------------------------------------------------------
+# Sampled loop: the section world and formation.neighbours
+# --------------------------------------------------------------------------
+
+_MASK64 = (1 << 64) - 1
+
+
+def splitmix64(x):
+    """splitmix64 of an integer, mod 2^64."""
+    z = (x + 0x9E3779B97F4A7C15) & _MASK64
+    z = ((z ^ (z >> 30)) * 0xBF58476D1CE4E5B9) & _MASK64
+    z = ((z ^ (z >> 27)) * 0x94D049BB133111EB) & _MASK64
+    return z ^ (z >> 31)
+
+
+def uniform_draw(seed, stream, count):
+    """U(seed, stream, count) = (splitmix64(splitmix64(seed) ^ (stream << 40 | count)) >> 11)
+    2^-53, in [0, 1)."""
+    key = ((stream << 40) | count) & _MASK64
+    return (splitmix64(splitmix64(seed) ^ key) >> 11) * 2.0 ** -53
+
+
+def uniform_draws(seed, stream, counts):
+    """uniform_draw() for an array of counts (numpy's uint64 arithmetic wraps mod 2^64)."""
+    counts = np.asarray(counts, dtype=np.uint64)
+    x = np.uint64(splitmix64(seed)) ^ (np.uint64((stream << 40) & _MASK64) | counts)
+    with np.errstate(over="ignore"):
+        z = x + np.uint64(0x9E3779B97F4A7C15)
+        z = (z ^ (z >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
+        z = (z ^ (z >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
+        z = z ^ (z >> np.uint64(31))
+    return (z >> np.uint64(11)).astype(np.float64) * 2.0 ** -53
+
+
+def normal_draws(seed, stream, counts):
+    """N(seed, stream, c) = sqrt(-2 ln(1 - U(2c))) cos(2 pi U(2c + 1)) (Box-Muller)."""
+    c = np.asarray(counts, dtype=np.uint64)
+    ua = uniform_draws(seed, stream, np.uint64(2) * c)
+    ub = uniform_draws(seed, stream, np.uint64(2) * c + np.uint64(1))
+    return np.sqrt(-2.0 * np.log(1.0 - ua)) * np.cos(2.0 * math.pi * ub)
+
+
+def gust_pulses(world, index, B, duration):
+    """The gusts of follower `index` as pulses (start, end, n-vector B g), stream 4 index.
+
+    Per gust, in this order of draws: the gap -ln(1 - U)/rate (from max(0, start)), the
+    duration min + U (max - min), the strength U magnitude, then m entries
+    sqrt(-2 ln(1 - U_a)) cos(2 pi U_b) of the direction (drawn again while of norm 0). A gust
+    starting at or after min(end, duration) ends the list; the others are cut there.
+    """
+    g = world.gusts
+    if not (g.rate > 0.0 and g.magnitude > 0.0):
+        return []
+    m = B.shape[1]
+    count = 0
+
+    def draw():
+        nonlocal count
+        value = uniform_draw(world.seed, 4 * index, count)
+        count += 1
+        return value
+
+    stop = min(g.end, duration)
+    t = max(0.0, g.start)
+    out = []
+    while True:
+        t += -math.log(1.0 - draw()) / g.rate
+        length = g.min_duration + draw() * (g.max_duration - g.min_duration)
+        strength = draw() * g.magnitude
+        while True:
+            direction = np.empty(m)
+            for e in range(m):
+                ua = draw()
+                ub = draw()
+                direction[e] = math.sqrt(-2.0 * math.log(1.0 - ua)) * math.cos(2.0 * math.pi * ub)
+            norm = float(np.linalg.norm(direction))
+            if norm > 0.0:
+                break
+        if t >= stop:
+            return out
+        out.append((t, min(t + length, stop), B @ (strength * direction / norm)))
+
+
+_SUBSETS = {}
+
+
+def _subsets(q, k):
+    """Index arrays (C, s) of the subsets of s of q half-spaces, s = 1 .. min(k, q)."""
+    key = (q, k)
+    if key not in _SUBSETS:
+        _SUBSETS[key] = [np.array(list(itertools.combinations(range(q), size)),
+                                  dtype=int).reshape(-1, size)
+                         for size in range(1, min(k, q) + 1)]
+    return _SUBSETS[key]
+
+
+def nearest_point(u, normals, bounds, amax, tol=1e-10):
+    """The point of {||x|| <= amax} cap {normals x >= bounds} (unit normals) nearest to u, or
+    None if the set is empty.
+
+    Exact, by enumerating active sets: the nearest point satisfies its KKT conditions with a
+    linearly independent set S of active half-spaces (|S| <= k) and the ball active or not, so
+    it is the candidate of one of them: u's projection onto the affine set {N_S x = b_S}
+    (x0 + P u, x0 the set's point nearest 0, P the projector onto N_S's null space), or the
+    point of that set on the sphere along P u, x0 + sqrt(amax^2 - |x0|^2) P u / |P u|. Every
+    feasible candidate is at least as far from u as the nearest point, so the nearest feasible
+    candidate is it (feasible: within tol, relative, of every half-space and the sphere).
+    """
+    k = u.size
+    ball = amax < math.inf
+    cands = [u[None, :]]
+    nu = float(np.linalg.norm(u))
+    if ball and nu > 0.0:
+        cands.append((u * (amax / nu))[None, :])
+    for idx in _subsets(bounds.size, k):
+        size = idx.shape[1]
+        Ns, bs = normals[idx], bounds[idx]                              # (C, s, k), (C, s)
+        if size == k:                                                   # vertices
+            ok = np.abs(np.linalg.det(Ns)) > 1e-7 if size > 1 else np.ones(len(idx), bool)
+            if np.any(ok):
+                cands.append(np.linalg.solve(Ns[ok], bs[ok][:, :, None])[:, :, 0])
+            continue
+        if size == 1:
+            Minv = np.ones((len(idx), 1, 1))
+        else:
+            M = Ns @ Ns.transpose(0, 2, 1)
+            ok = np.abs(np.linalg.det(M)) > 1e-14
+            Ns, bs, M = Ns[ok], bs[ok], M[ok]
+            if not len(M):
+                continue
+            Minv = np.linalg.inv(M)
+        x0 = np.einsum("csk,cs->ck", Ns, np.einsum("cst,ct->cs", Minv, bs))
+        Pu = u - np.einsum("csk,cs->ck", Ns, np.einsum("cst,ct->cs", Minv, Ns @ u))
+        cands.append(x0 + Pu)
+        if ball:
+            r2 = amax * amax - np.sum(x0 * x0, axis=1)
+            nw = np.linalg.norm(Pu, axis=1)
+            good = (r2 >= 0.0) & (nw > 0.0)
+            if np.any(good):
+                cands.append(x0[good] + (np.sqrt(r2[good]) / nw[good])[:, None] * Pu[good])
+    X = np.vstack(cands)
+    feasible = np.all(X @ normals.T >= bounds - tol * np.maximum(1.0, np.abs(bounds)), axis=1)
+    if ball:
+        feasible &= np.linalg.norm(X, axis=1) <= amax * (1.0 + tol)
+    if not np.any(feasible):
+        return None
+    X = X[feasible]
+    return X[int(np.argmin(np.linalg.norm(X - u, axis=1)))]
+
+
+def project_command(u, normals, bounds, amax):
+    """(N3): u's Euclidean projection onto the ball ||x|| <= amax and the half-spaces (rows in
+    priority order). If that set is empty, the half-spaces are taken in priority order, each
+    dropped whose addition empties the set with the ball; the projection is onto the rest.
+    Returns (projection, how many half-spaces were dropped)."""
+    x = nearest_point(u, normals, bounds, amax)
+    if x is not None:
+        return x, 0
+    keep = []
+    witness = np.zeros_like(u)          # a point of the ball and the kept half-spaces
+    for j in range(bounds.size):
+        if bounds[j] > amax * (1.0 + 1e-10):
+            continue                    # outside the ball
+        if normals[j] @ witness >= bounds[j] - 1e-10 * max(1.0, abs(bounds[j])):
+            keep.append(j)              # the witness is in it too
+            continue
+        trial = keep + [j]
+        point = nearest_point(np.zeros_like(u), normals[trial], bounds[trial], amax)
+        if point is not None:
+            keep, witness = trial, point
+    x = nearest_point(u, normals[keep], bounds[keep], amax)
+    return x, bounds.size - len(keep)
+
+
+def neighbour_halfspaces(nb, P, V, targets, own_perimeter, amax):
+    """(N1), (N2) for every follower against every other agent, at once.
+
+    P, V (F + 1, k) the agents' true positions and velocities (row 0 the leader); targets (F,)
+    the agent each follower looks at. Returns (normals (F, F + 1, k), bounds b, urgency h,
+    distance c, valid (F, F + 1)): follower i's half-space against agent j is normals.u >= b,
+    valid where j is sensed (not i, c <= radius) and b is finite and > -amax.
+    """
+    F = len(targets)
+    dp = P[1:, None, :] - P[None, :, :]
+    dv = V[1:, None, :] - V[None, :, :]
+    c = np.sqrt(np.sum(dp * dp, axis=2))
+    safe_c = np.where(c > 0.0, c, 1.0)
+    x_axis = np.zeros(P.shape[1])
+    x_axis[0] = 1.0
+    normals = np.where((c > 0.0)[:, :, None], dp / safe_c[:, :, None], x_axis)
+    nv = np.sum(normals * dv, axis=2)
+    closing = -nv                                                    # s
+    v_perp2 = np.maximum(0.0, np.sum(dv * dv, axis=2) - nv * nv)
+    rho = np.full(c.shape, nb.perimeter)
+    rho[np.arange(F), targets] = own_perimeter
+    outside = c > rho
+    root = np.sqrt(2.0 * nb.braking_acceleration * np.where(outside, c - rho, 1.0))
+    h = np.where(outside, root - closing, -math.inf)                                    # (N1)
+    with np.errstate(invalid="ignore"):
+        b = np.where(outside,
+                     nb.braking_acceleration * closing / root - v_perp2 / safe_c
+                     + nb.neighbour_acceleration - nb.rate * h,                         # (N2)
+                     nb.braking_acceleration + nb.neighbour_acceleration)
+    not_self = np.ones(c.shape, dtype=bool)
+    not_self[np.arange(F), np.arange(1, F + 1)] = False
+    valid = not_self & (c <= nb.radius) & np.isfinite(b) & (b > -amax)
+    return normals, b, h, c, valid
+
+
+def chain_layout(formation, d, k):
+    """d_i of a chain (doc/formations.md): d for a line; R(+-half_angle) d for a V."""
+    out = []
+    for i in range(1, formation.followers + 1):
+        if formation.shape == "line":
+            out.append(d.copy())
+            continue
+        di = d.copy()
+        di[:k] = rotate_z(d[:k], formation.half_angle if i % 2 else -formation.half_angle)
+        out.append(di)
+    return out
+
+
+def formation_targets(formation):
+    """The agent each follower looks at (0 the leader, i follower i)."""
+    if formation is None:
+        return [0]
+    N = formation.followers
+    if formation.topology == "star":
+        return [0] * N
+    lag = 1 if formation.shape == "line" else 2
+    return [max(0, i - lag) for i in range(1, N + 1)]
+
+
+class ExactStep:
+    """x(t + delta) = Phi(delta) x + Psi(delta) v for x' = A x + v, v constant (cached)."""
+
+    def __init__(self, A, double_integrator):
+        self.A, self.di, self.cache = A, double_integrator, {}
+
+    def __call__(self, delta):
+        hit = self.cache.get(delta)
+        if hit is None:
+            n = self.A.shape[0]
+            if self.di:                      # A^2 = 0
+                hit = (np.eye(n) + self.A * delta, np.eye(n) * delta + self.A * (0.5 * delta ** 2))
+            else:
+                big = np.zeros((2 * n, 2 * n))
+                big[:n, :n], big[:n, n:] = self.A, np.eye(n)
+                E = expm(big * delta)
+                hit = (E[:n, :n], E[:n, n:])
+            if len(self.cache) < 4096:
+                self.cache[delta] = hit
+        return hit
+
+
+def _piecewise(pulses, sinusoids, grid, n):
+    """Per period [t_k, t_k+1): the pulses' and sinusoids' sum at its middle (N, n), whether a
+    pulse edge lies inside it (N,), and the sorted edges."""
+    edges = np.array(sorted({e for a, b, _ in pulses for e in (a, b)}))
+    mids = 0.5 * (grid[:-1] + grid[1:])
+    value = (pulse_sum(pulses, mids, n) + sinusoid_sum(sinusoids, mids, n)).T
+    if edges.size:
+        inside = (np.searchsorted(edges, grid[1:], "left")
+                  > np.searchsorted(edges, grid[:-1], "right"))
+    else:
+        inside = np.zeros(mids.size, dtype=bool)
+    return value, inside, edges
+
+
+def _segments(edges, a, b):
+    """[a, b] cut at the edges strictly inside it."""
+    lo, hi = np.searchsorted(edges, a, "right"), np.searchsorted(edges, b, "left")
+    return [a] + [float(e) for e in edges[lo:hi]] + [b]
+
+
+def advance(x, drive, pulses, sinusoids, edges, a, b, step, B, value_mid, cut):
+    """One agent over [a, b]: the input `drive` (m) held, the pulses and sinusoids (n) constant
+    on each piece of the period cut at the pulse edges, at its middle."""
+    if not cut:
+        Phi, Psi = step(b - a)
+        return Phi @ x + Psi @ (B @ drive + value_mid)
+    cuts = _segments(edges, a, b)
+    for lo, hi in zip(cuts[:-1], cuts[1:]):
+        mid = 0.5 * (lo + hi)
+        v = B @ drive + pulse_sum(pulses, mid, B.shape[0])[:, 0]
+        if sinusoids:
+            v = v + sinusoid_sum(sinusoids, mid, B.shape[0])[:, 0]
+        Phi, Psi = step(hi - lo)
+        x = Phi @ x + Psi @ v
+    return x
+
+
+def simulate_sampled(sc):
+    """The sampled loop of doc/math.md ('Follower command', 'Discretisation', 'Offline
+    simulator') with the section world and formation.neighbours (N1)-(N3), every agent at once.
+
+    Returns (names, targets (F,), per-follower column dicts, pair minima (F+1, F+1), wall s).
+    """
+    wall0 = time.perf_counter()
+    fm = sc.formation
+    n, m, k = sc.n, sc.m, sc.k
+    T = 1.0 / sc.control_rate
+    grid = time_grid(sc)
+    N = grid.size - 1
+    targets = np.array(formation_targets(fm))
+    F = targets.size
+    if fm is None:
+        D = np.array([sc.d])
+    elif fm.topology == "chain":
+        D = np.array(chain_layout(fm, sc.d, k))
+    else:
+        D = np.array(slot_layout(fm, sc.d, k))
+    d_norm = np.linalg.norm(D, axis=1)
+    xi_max = (1.0 - sc.alpha) * d_norm
+    own_perimeter = sc.alpha * d_norm
+    world = sc.world if sc.world is not None else World()
+    nb = fm.neighbours if fm is not None else None
+
+    # Agents: row 0 the leader, row i follower i; each follower starts with the scenario's xi_0.
+    xi0 = sc.x1_0 - sc.x2_0 - sc.d
+    X = np.zeros((F + 1, n))
+    X[0] = sc.x1_0
+    for i in range(1, F + 1):
+        X[i] = X[targets[i - 1]] - D[i - 1] - xi0
+
+    # The world of each follower: vehicle, pulses (its own and its gusts), sinusoids, noise.
+    vehicles, pulses, sines = [], [], []
+    for i in range(1, F + 1):
+        fw = world.followers.get(i)
+        vehicles.append(fw.vehicle if fw else world.vehicle)
+        pulses.append((list(fw.disturbances) if fw else [])
+                      + gust_pulses(world, i, sc.B, sc.duration))
+        sines.append(list(fw.sinusoids) if fw else [])
+    v_limit = np.array([v.acceleration_limit for v in vehicles])
+    v_gain = np.array([v.input_gain for v in vehicles])
+    v_lag = np.array([v.actuator_lag for v in vehicles])
+    v_beta = np.where(v_lag > 0.0, -np.expm1(-T / np.where(v_lag > 0.0, v_lag, 1.0)), 1.0)
+    sigma = np.where(np.arange(n) < k, world.noise_position, world.noise_velocity)
+    if np.any(sigma > 0.0):
+        counts = (np.arange(N + 1, dtype=np.uint64)[:, None] * np.uint64(n)
+                  + np.arange(n, dtype=np.uint64)[None, :])
+        noise = np.stack([sigma * normal_draws(world.seed, 4 * i + 1, counts)
+                          for i in range(1, F + 1)])                    # (F, N + 1, n)
+    else:
+        noise = np.zeros((F, N + 1, n))
+    follower_drive = [_piecewise(pulses[i], sines[i], grid, n) for i in range(F)]
+    leader_drive = _piecewise(sc.disturbances, [], grid, n)
+    u1_grid = (pulse_sum(sc.input_pulses, grid, m) + sinusoid_sum(sc.sinusoids, grid, m)).T
+    ud_grid = pulse_sum(sc.disturbances, grid, n).T
+    step = ExactStep(sc.A, sc.double_integrator)
+
+    XH = np.zeros((F, n))
+    U_prev = np.zeros((F, m))
+    Z = np.zeros((F, m))                          # the vehicles' lag states, z_{-1} = 0
+    Fm = sc.F                                     # A_c + L C
+    delta = T / sc.substeps
+    xm2 = xi_max ** 2
+    rec = {key: np.zeros((N + 1, F, size)) for key, size in
+           (("xi", n), ("xi_hat", n), ("x", n), ("target", n), ("u", m), ("u_baseline", m),
+            ("u_tracker", m), ("u_applied", m), ("noise", n))}
+    rec_f = {key: np.zeros((N + 1, F)) for key in ("f", "kept", "dropped", "projected",
+                                                   "saturated", "rate_limited")}
+    pair_min = np.full((F + 1, F + 1), math.inf)
+    leader_told = np.where(targets == 0, 1.0, 0.0)[:, None]
+
+    def field_at(xh, c):
+        hh = xh @ Fm.T + c
+        fval = ((1.0 + sc.epsilon) * np.sum(xh * xh, axis=1) - xm2) / (sc.epsilon * xm2)
+        grad_h = np.sum(xh * hh, axis=1)
+        active = (fval > 0.0) & (grad_h > 0.0)
+        gx = xh @ sc.Gamma_inv.T
+        denom = np.sum(xh * gx, axis=1)
+        scale = np.where(active, fval * grad_h / np.where(active, denom, 1.0), 0.0)
+        return hh - gx * scale[:, None]
+
+    for tick in range(N + 1):
+        t = grid[tick]
+        pos = X[:, :k]
+        diff = pos[:, None, :] - pos[None, :, :]
+        pair_min = np.minimum(pair_min, np.sqrt(np.sum(diff * diff, axis=2)))
+        xi = X[targets] - X[1:] - D
+        y = (xi + noise[:, tick]) @ sc.C.T
+        if tick == 0:
+            if sc.initial_estimate == "zero":
+                XH = np.zeros((F, n))
+            else:
+                XH = y @ np.linalg.pinv(sc.C).T
+                norm = np.linalg.norm(XH, axis=1)
+                over = norm > xi_max
+                XH[over] *= (xi_max[over] / norm[over])[:, None]
+        rec["xi"][tick], rec["xi_hat"][tick] = xi, XH
+        rec["x"][tick], rec["target"][tick], rec["noise"][tick] = X[1:], X[targets], noise[:, tick]
+        rec_f["f"][tick] = (((1.0 + sc.epsilon) * np.sum(XH * XH, axis=1) - xm2)
+                            / (sc.epsilon * xm2))
+
+        u1 = u1_grid[tick]
+        a1 = u1 + sc.B_pinv @ ud_grid[tick] if sc.info_disturbance else u1
+        uff = leader_told * a1 if sc.info_command else np.zeros((F, m))
+        w = (leader_told * a1 - uff) @ sc.B.T if sc.info_estimator else np.zeros((F, n))
+        yh = XH @ sc.C.T
+        ua = ((y - yh) @ sc.Ge.T + yh @ sc.S21.T) if sc.tracker else np.zeros((F, m))
+        ub = y @ sc.G.T
+        u = ub + ua + uff
+        norm = np.linalg.norm(u, axis=1)
+        saturated = norm > sc.acceleration_limit
+        u[saturated] *= (sc.acceleration_limit / norm[saturated])[:, None]
+        rate_limited = np.zeros(F, dtype=bool)
+        if sc.jerk_limit < math.inf:
+            du = u - U_prev
+            dn = np.linalg.norm(du, axis=1)
+            rate_limited = dn > sc.jerk_limit * T
+            u[rate_limited] = (U_prev[rate_limited] + du[rate_limited]
+                               * (sc.jerk_limit * T / dn[rate_limited])[:, None])
+        projected = np.zeros(F, dtype=bool)
+        if nb is not None:
+            amax = sc.acceleration_limit
+            normals, bounds, urgency, dist, valid = neighbour_halfspaces(
+                nb, X[:, :k], X[:, k:2 * k], targets, own_perimeter, amax)
+            along = np.einsum("ijk,ik->ij", normals, u)
+            slack = 1e-12 * np.maximum(1.0, np.abs(bounds))
+            for i in np.nonzero(np.any(valid & (along < bounds - slack), axis=1))[0]:
+                idx = np.nonzero(valid[i])[0]
+                order = np.lexsort((dist[i, idx], urgency[i, idx]))[:nb.max_neighbours]
+                idx = idx[order]
+                if not np.any(along[i, idx] < bounds[i, idx] - slack[i, idx]):
+                    continue                          # only unkept half-spaces are violated
+                x, dropped = project_command(u[i], normals[i, idx], bounds[i, idx], amax)
+                rec_f["dropped"][tick, i] = dropped
+                if not np.array_equal(x, u[i]):
+                    u[i] = x
+                    projected[i] = True
+            rec_f["kept"][tick] = np.minimum(np.sum(valid, axis=1), nb.max_neighbours)
+        U_prev = u.copy()
+        acts = saturated | rate_limited | projected
+        aug = np.where(acts[:, None], u - ub - uff, ua)        # the augmentation that acts
+        rec["u"][tick], rec["u_baseline"][tick], rec["u_tracker"][tick] = u, ub, aug
+        rec_f["projected"][tick], rec_f["saturated"][tick] = projected, saturated
+        rec_f["rate_limited"][tick] = rate_limited
+
+        # The true vehicles: saturation, lag, gain.
+        s = u.copy()
+        norm = np.linalg.norm(s, axis=1)
+        over = norm > v_limit
+        s[over] *= (v_limit[over] / norm[over])[:, None]
+        Z = np.where((v_lag > 0.0)[:, None], Z + v_beta[:, None] * (s - Z), s)
+        drive = v_gain[:, None] * Z
+        rec["u_applied"][tick] = drive
+        if tick == N:
+            break
+
+        # The estimator over the period: RK4 substeps with y, the augmentation and w held; an
+        # estimate outside the hard sphere after a substep is scaled back onto it.
+        c = w - aug @ sc.B.T - y @ sc.L.T
+        for _ in range(sc.substeps):
+            k1 = field_at(XH, c)
+            k2 = field_at(XH + 0.5 * delta * k1, c)
+            k3 = field_at(XH + 0.5 * delta * k2, c)
+            k4 = field_at(XH + delta * k3, c)
+            XH = XH + (delta / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+            norm = np.linalg.norm(XH, axis=1)
+            out = norm > xi_max
+            XH[out] *= (xi_max[out] / norm[out])[:, None]
+
+        # The plants, exactly over [t_k, t_k+1]: inputs held, pulses cut at their edges.
+        a, b = t, grid[tick + 1]
+        value, cut, edges = leader_drive
+        X_next = np.empty_like(X)
+        X_next[0] = advance(X[0], u1, sc.disturbances, [], edges, a, b, step, sc.B,
+                            value[tick], cut[tick])
+        Phi, Psi = step(b - a)
+        plain = [i for i in range(F) if not follower_drive[i][1][tick]]
+        if plain:
+            mids = np.array([follower_drive[i][0][tick] for i in plain])
+            V = drive[plain] @ sc.B.T + mids
+            X_next[np.array(plain) + 1] = X[np.array(plain) + 1] @ Phi.T + V @ Psi.T
+        for i in range(F):
+            if follower_drive[i][1][tick]:
+                value, cut, edges = follower_drive[i]
+                X_next[i + 1] = advance(X[i + 1], drive[i], pulses[i], sines[i], edges, a, b,
+                                        step, sc.B, value[tick], True)
+        X = X_next
+    wall = time.perf_counter() - wall0
+
+    names = [f"follower_{i}" for i in range(1, F + 1)] if fm is not None else [None]
+    runs = []
+    for i in range(F):
+        cols = {"t": grid}
+        for e in range(n):
+            cols[f"xi_{e}"] = rec["xi"][:, i, e]
+        for e in range(n):
+            cols[f"xi_hat_{e}"] = rec["xi_hat"][:, i, e]
+        cols["norm_xi"] = np.linalg.norm(rec["xi"][:, i], axis=1)
+        cols["norm_xi_hat"] = np.linalg.norm(rec["xi_hat"][:, i], axis=1)
+        cols["xi_max"] = np.full(N + 1, xi_max[i])
+        cols["xi_soft"] = np.full(N + 1, xi_max[i] / math.sqrt(1.0 + sc.epsilon))
+        cols["f"] = rec_f["f"][:, i]
+        for e in range(k):
+            cols[f"leader_p_{e}"] = rec["target"][:, i, e]
+        for e in range(k):
+            cols[f"follower_p_{e}"] = rec["x"][:, i, e]
+        if sc.double_integrator:
+            for e in range(k):
+                cols[f"leader_v_{e}"] = rec["target"][:, i, k + e]
+            for e in range(k):
+                cols[f"follower_v_{e}"] = rec["x"][:, i, k + e]
+        cols["separation"] = np.linalg.norm(rec["target"][:, i, :k] - rec["x"][:, i, :k], axis=1)
+        cols["perimeter"] = np.full(N + 1, own_perimeter[i])
+        for name in ("u", "u_baseline", "u_tracker", "u_applied"):
+            for e in range(m):
+                cols[f"{name}_{e}"] = rec[name][:, i, e]
+        for e in range(m):
+            cols[f"leader_u_{e}"] = u1_grid[:, e]
+        for e in range(n):
+            cols[f"noise_{e}"] = rec["noise"][:, i, e]
+        for name in ("saturated", "rate_limited", "projected", "kept", "dropped"):
+            cols[name] = rec_f[name][:, i]
+        runs.append((names[i], cols, xi_max[i]))
+    return runs, targets, pair_min, wall
+
+
+def pair_figures(pair_min, targets, perimeter):
+    """The formation line's figures from the pairs' smallest distances (agents 0 .. F, 0 the
+    leader): min_pair_separation, perimeter, min_neighbour_separation (pairs of which neither
+    looks at the other), pairs_inside_perimeter and neighbour_pairs_inside_perimeter (pairs that
+    came closer than the perimeter at some tick)."""
+    agents = pair_min.shape[0]
+    target_of = {i: int(targets[i - 1]) for i in range(1, agents)}
+    every, neighbours = [], []
+    for b in range(1, agents):
+        for a in range(b):
+            every.append(pair_min[a, b])
+            if target_of.get(a) != b and target_of.get(b) != a:
+                neighbours.append(pair_min[a, b])
+    return {"min_pair_separation": min(every, default=math.inf),
+            "perimeter": perimeter,
+            "min_neighbour_separation": min(neighbours, default=math.inf),
+            "pairs_inside_perimeter": sum(1 for v in every if v < perimeter),
+            "neighbour_pairs_inside_perimeter": sum(1 for v in neighbours if v < perimeter)}
+
+
+def run_sampled(sc, csv_path=None):
+    """Run the sampled loop and print cf_sim's lines; returns an exit status."""
+    runs, targets, pair_min, wall = simulate_sampled(sc)
+    for i, (name, cols, xi_max) in enumerate(runs):
+        if csv_path:
+            path = follower_csv_path(csv_path, name) if name else csv_path
+            try:
+                write_csv(path, cols)
+            except OSError as exc:
+                print(f"{PROG}: error: cannot write {path}: {exc.strerror}", file=sys.stderr)
+                return 1
+        norm_xi = cols["norm_xi"]
+        figures = {"max_xi": float(np.max(norm_xi)),
+                   "max_xi_hat": float(np.max(cols["norm_xi_hat"])), "xi_max": xi_max,
+                   "min_separation": float(np.min(cols["separation"])),
+                   "time_outside": int(np.count_nonzero(norm_xi > xi_max)) / sc.control_rate,
+                   "wall_s": wall}
+        line = " ".join(f"{key}={value:.9g}" for key, value in figures.items())
+        target = "leader" if targets[i] == 0 else f"follower_{targets[i]}"
+        print(f"{name} target={target} {line}" if name else line, flush=True)
+    if sc.formation is not None:
+        print(formation_line(sc, pair_figures(pair_min, targets, sc.perimeter), wall))
+    return 0
+
+
+def formation_line(sc, figures, wall):
+    fm = sc.formation
+    text = " ".join(f"{key}={value:.9g}" if isinstance(value, float) else f"{key}={value}"
+                    for key, value in figures.items())
+    return (f"formation followers={fm.followers} topology={fm.topology} shape={fm.shape} "
+            f"slots={fm.slots} {text} wall_s={wall:.9g}")
+
+
+# --------------------------------------------------------------------------
 # Command line
 # --------------------------------------------------------------------------
 
@@ -1079,6 +1948,8 @@ def parse_args(argv):
     ap.add_argument("--max-step", type=float, default=math.inf,
                     help="largest step, s (default: no limit)")
     ap.add_argument("--csv", metavar="FILE", help="write the sampled signals to FILE")
+    ap.add_argument("--sampled", action="store_true",
+                    help="run the sampled loop (as with a section world or formation.neighbours)")
     return ap.parse_args(argv)
 
 
@@ -1101,24 +1972,27 @@ def follower_csv_path(path, name):
     return f"{root}_{name}{ext}"
 
 
-def min_pair_separation(runs, k):
-    """Smallest distance between any two agents (the leader and the followers) on the grid."""
+def pair_minima(runs, k):
+    """(F + 1, F + 1): the smallest distance between each two agents (0 the leader, i follower
+    i) on the grid."""
     points = [np.vstack([runs[0][2][f"leader_p_{i}"] for i in range(k)])]
     points += [np.vstack([cols[f"follower_p_{i}"] for i in range(k)]) for _, _, cols, _ in runs]
-    best = math.inf
+    out = np.full((len(points), len(points)), math.inf)
     for j in range(1, len(points)):
         for i in range(j):
-            best = min(best, float(np.min(np.linalg.norm(points[j] - points[i], axis=0))))
-    return best
+            out[i, j] = out[j, i] = float(np.min(np.linalg.norm(points[j] - points[i], axis=0)))
+    return out
 
 
 def main(argv=None):
     args = parse_args(argv)
     try:
-        sc = load_scenario(args.scenario, args.overrides)
+        sc = load_scenario(args.scenario, args.overrides, args.sampled)
     except ScenarioError as exc:
         print(f"{PROG}: error: {exc}", file=sys.stderr)
         return 2
+    if sc.sampled:
+        return run_sampled(sc, args.csv)
     runs = []
     for name, fsc in follower_scenarios(sc):
         try:
@@ -1139,10 +2013,8 @@ def main(argv=None):
         print(f"{name} target=leader {line}" if name else line, flush=True)
         runs.append((name, fsc, cols, wall))
     if sc.formation is not None:
-        fm = sc.formation
-        print(f"formation followers={fm.followers} topology={fm.topology} shape={fm.shape} "
-              f"slots={fm.slots} min_pair_separation={min_pair_separation(runs, sc.k):.9g} "
-              f"wall_s={sum(r[3] for r in runs):.9g}")
+        figures = pair_figures(pair_minima(runs, sc.k), [0] * len(runs), sc.perimeter)
+        print(formation_line(sc, figures, sum(r[3] for r in runs)))
     return 0
 
 

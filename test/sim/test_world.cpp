@@ -199,6 +199,39 @@ TEST(World, NoiseAndVehiclesChangeTheRunAndSeedsRepeatIt) {
   EXPECT_NE(lagging.followers[0].max_xi, quiet.followers[0].max_xi);
 }
 
+TEST(Neighbours, KeepTheGustedFollowerOutOfItsSiblingsPerimeter) {
+  // The V of 4 with the gust on follower 2: inside without formation.neighbours, outside with
+  // it (a_b + A_n = the 3 m/s^2 limit; A_n = 2 m/s^2, what the gust leaves follower 2 after its
+  // vehicle's 3 m/s^2).
+  std::vector<std::string> limited{"controller.acceleration_limit=3"};
+  const FormationSummary alone = run("crowd_v4_gust.yaml", limited);
+  std::vector<std::string> protected_sets = limited;
+  protected_sets.emplace_back(
+      "formation.neighbours={braking_acceleration: 1, neighbour_acceleration: 2, rate: 1}");
+  const FormationSummary guarded = run("crowd_v4_gust.yaml", protected_sets);
+  EXPECT_LT(alone.min_pair_separation, alone.perimeter);
+  EXPECT_GE(guarded.min_pair_separation, guarded.perimeter);
+  EXPECT_EQ(guarded.pairs_inside_perimeter, 0);
+  // In calm weather nothing comes near: the barriers never bind and the run is the same.
+  limited.emplace_back("world.followers=[]");
+  protected_sets.emplace_back("world.followers=[]");
+  expectSameRun(run("crowd_v4_gust.yaml", limited), run("crowd_v4_gust.yaml", protected_sets));
+}
+
+TEST(NeighbourKeys, EachBadValueIsRefusedByName) {
+  auto keyOf = [](const std::string& set) {
+    return keyOfError({"controller.acceleration_limit=3", set});
+  };
+  EXPECT_EQ(keyOf("formation.neighbours={braking_acceleration: 2, neighbour_acceleration: 2}"),
+            "formation.neighbours.braking_acceleration");
+  EXPECT_EQ(keyOf("formation.neighbours={rate: -1}"), "formation.neighbours.rate");
+  EXPECT_EQ(keyOf("formation.neighbours={max_neighbours: 0}"),
+            "formation.neighbours.max_neighbours");
+  EXPECT_EQ(keyOf("formation.neighbours={radius: .nan}"), "formation.neighbours.radius");
+  EXPECT_EQ(keyOf("formation.neighbours={reach: 3}"), "formation.neighbours.reach");
+  EXPECT_EQ(keyOf("formation.neighbours={}"), "");
+}
+
 TEST(WorldKeys, EachBadValueIsRefusedByName) {
   EXPECT_EQ(keyOfError({"world.vehicle.acceleration_limit=0"}), "world.vehicle.acceleration_limit");
   EXPECT_EQ(keyOfError({"world.vehicle.input_gain=-1"}), "world.vehicle.input_gain");

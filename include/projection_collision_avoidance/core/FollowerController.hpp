@@ -98,6 +98,7 @@ class FollowerController {
   const FollowerControllerStatus<Dims>& step(const StepInputs<Dims>& inputs) {
     const bool leader_input_known = inputs.leader_input.has_value();
     period_fraction_ = inputs.period_fraction;
+    constraints_ = inputs.command_constraints;
     setSlotAcceleration(inputs.slot_acceleration ? &*inputs.slot_acceleration : nullptr);
     return tick(inputs.measurement ? &*inputs.measurement : nullptr,
                 leader_input_known ? *inputs.leader_input : InputVector::Zero(input_matrix_.cols()),
@@ -211,8 +212,9 @@ class FollowerController {
     status_.fallback_command.setZero();
     status_.fallback = false;
     status_.command_rate_limited = rate_limiter_.limit(status_.command, period_fraction_);
-    const InputVector acting =
-        law_.acting(terms_, status_.command, known_feedforward_, status_.command_rate_limited);
+    const bool projected = constrainCommand();
+    const InputVector acting = law_.acting(terms_, status_.command, known_feedforward_,
+                                           status_.command_rate_limited || projected);
     const EstimatorPeriodReport report =
         estimator_.advance(y, acting, knownDrift(leader_input, leader_input_known), design_.period,
                            design_.parameters.estimator_substeps);
@@ -241,6 +243,7 @@ class FollowerController {
       status_.command = known_feedforward_;
     }
     limitCommand();
+    constrainCommand();
 
     // xi' = A xi + B (u_1 - u_ff) - B (u_2 - u_ff - u_r), with u_1 - u_ff modelled as in step()
     // and u_r the turning slot's acceleration (T3).
@@ -290,6 +293,36 @@ class FollowerController {
   /// The fallback's limits: sat() of (10) (saturateCommand(): euclideanNorm(command) <=
   /// acceleration_limit exactly, no overflow), then the change from the previous tick's command
   /// limited to jerk_limit T, inside the same ball.
+  /// (N3): the command projected onto the given half-spaces and ||u|| <= acceleration_limit,
+  /// the less urgent half-spaces dropped when they cannot all be met; the projected command
+  /// becomes the rate limit's previous one (the neighbours come before the jerk limit). True
+  /// when it moved the command.
+  bool constrainCommand() {
+    status_.command_projected = false;
+    status_.constraints_given = 0;
+    status_.constraints_active = 0;
+    status_.constraints_dropped = 0;
+    const Eigen::Index m = status_.command.size();
+    if (constraints_ == nullptr || constraints_->size() == 0 || m > 3 ||
+        constraints_->dimension() != m) {
+      return false;
+    }
+    Eigen::Vector3d nominal = Eigen::Vector3d::Zero();
+    nominal.head(m) = status_.command;
+    const CommandProjectionResult result =
+        constraints_->project(nominal, design_.parameters.acceleration_limit);
+    status_.constraints_given = constraints_->size();
+    status_.constraints_active = result.active;
+    status_.constraints_dropped = result.dropped;
+    if (!result.changed) {
+      return false;
+    }
+    status_.command = result.command.head(m);
+    rate_limiter_.setPrevious(status_.command);
+    status_.command_projected = true;
+    return true;
+  }
+
   void limitCommand() {
     status_.command_saturated =
         saturateCommand(&status_.command, design_.parameters.acceleration_limit);
@@ -310,6 +343,7 @@ class FollowerController {
   InputVector known_feedforward_;  // u_ff + u_r: the command's known inputs of this tick
   bool slot_acting_ = false;       // u_r given at this step
   double period_fraction_ = 1.0;   // of this step (StepInputs::period_fraction)
+  const CommandProjection* constraints_ = nullptr;  // of this step (StepInputs)
   bool initialized_ = false;
 };
 

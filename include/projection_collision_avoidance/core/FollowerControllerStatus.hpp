@@ -38,6 +38,13 @@ struct FollowerControllerStatus {
   bool command_overflow = false;
   /// The estimator discarded a non-finite substep and held the estimate (EstimatorPeriodReport).
   bool estimate_held = false;
+  /// The neighbours' half-spaces (N3) moved the command (StepInputs::command_constraints).
+  bool command_projected = false;
+  /// Half-spaces the command was given this tick, held with equality by it, and dropped because
+  /// they could not all be met (the less urgent ones; (N3)).
+  int constraints_given = 0;
+  int constraints_active = 0;
+  int constraints_dropped = 0;
 
   FollowerControllerStatus() = default;
   /// The same status in other (compatible) dimensions, e.g. fixed to bounded: the one place that
@@ -68,6 +75,10 @@ struct FollowerControllerStatus {
     slot_acceleration_rejected = other.slot_acceleration_rejected;
     command_overflow = other.command_overflow;
     estimate_held = other.estimate_held;
+    command_projected = other.command_projected;
+    constraints_given = other.constraints_given;
+    constraints_active = other.constraints_active;
+    constraints_dropped = other.constraints_dropped;
     return *this;
   }
 };

@@ -8,6 +8,7 @@
 #include "projection_collision_avoidance/core/AgentModel.hpp"
 #include "projection_collision_avoidance/core/ControllerParameters.hpp"
 #include "projection_collision_avoidance/core/ConvoyReference.hpp"
+#include "projection_collision_avoidance/core/NeighbourBarrier.hpp"
 #include "projection_collision_avoidance/core/TurningSlot.hpp"
 
 namespace projection_collision_avoidance {
@@ -42,6 +43,7 @@ struct FormationSpec {
   SlotFrame slots = SlotFrame::kWorld;     ///< formation.slots
   SlotHeadingParameters turning;           ///< formation.turning (slots: turning)
   ConvoyParameters path;                   ///< formation.path (slots: path)
+  NeighbourParameters neighbours;          ///< formation.neighbours (N1)-(N3)
 
   static constexpr int kMaxFollowers = 1000;
 
@@ -55,6 +57,10 @@ struct FormationSpec {
   /// input and time headway when they are on (a convoy follower tracks its own reference point:
   /// doc/math.md, (C4)).
   void validateConvoy(const ControllerParameters& controller) const;
+  /// With formation.neighbours: throws ParameterError naming formation.neighbours (a model that
+  /// is not a double integrator of 1 to 3 axes) or formation.neighbours.* (a value out of range,
+  /// NeighbourParameters::validate() against controller.acceleration_limit).
+  void validateNeighbours(const ControllerParameters& controller) const;
 };
 
 /// One follower of a formation, with everything that differs from one follower to the next.

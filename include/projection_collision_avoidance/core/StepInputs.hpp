@@ -4,6 +4,7 @@
 
 #include <Eigen/Core>
 
+#include "projection_collision_avoidance/core/CommandProjection.hpp"
 #include "projection_collision_avoidance/core/TypeDefs.hpp"
 
 namespace projection_collision_avoidance {
@@ -26,6 +27,9 @@ struct StepInputs {
   /// rate limit scales its allowed change by (jerk_limit Delta t; CommandRateLimiter::limit());
   /// 1 (the default): a whole period.
   double period_fraction = 1.0;
+  /// Half-spaces g_j^T u >= b_j the command must lie in (the neighbours' barriers, (N3)), most
+  /// important first, of the command's size; null or empty: none. Not owned.
+  const CommandProjection* command_constraints = nullptr;
 };
 
 /// StepInputs of any sizes, the argument of DynamicFollowerController::step(): each entry a
@@ -36,6 +40,7 @@ struct DynamicStepInputs {
   std::optional<Eigen::Ref<const Eigen::VectorXd>> own_state{};          ///< x_2 (m, m/s)
   std::optional<Eigen::Ref<const Eigen::VectorXd>> slot_acceleration{};  ///< u_r (m/s^2)
   double period_fraction = 1.0;  ///< Delta t / T since the previous step (StepInputs)
+  const CommandProjection* command_constraints = nullptr;  ///< (N3), as in StepInputs
 };
 
 }  // namespace projection_collision_avoidance
