@@ -30,6 +30,7 @@ SimulationCsvWriter::SimulationCsvWriter(std::ostream& out, const Scenario& scen
       velocities_(scenario.controller.model.isDoubleIntegrator()),
       turning_(scenario.formation.slots == SlotFrame::kTurning),
       path_(scenario.formation.slots == SlotFrame::kPath),
+      neighbours_(scenario.formation.neighbours.enabled),
       xi_max_(hardBound(scenario.controller.alpha, scenario.controller.separation.norm())),
       xi_soft_(softBound(xi_max_, scenario.controller.epsilon)),  // xi_max_ is set above
       perimeter_(
@@ -62,6 +63,9 @@ SimulationCsvWriter::SimulationCsvWriter(std::ostream& out, const Scenario& scen
     writeHeaderColumns(out_, "ref_p_", positions_);
     writeHeaderColumns(out_, "goal_p_", positions_);
     out_ << ",progress,goal_arc,chord,braking";
+  }
+  if (neighbours_) {
+    out_ << ",command_projected,constraints_given,constraints_active,constraints_dropped";
   }
   out_ << '\n';
 }
@@ -98,6 +102,10 @@ void SimulationCsvWriter::write(const SimulationSample& s) {
     writeValues(out_, s.convoy.goal, positions_);
     out_ << ',' << s.convoy.progress << ',' << s.convoy.goal_arc << ',' << s.convoy.chord << ','
          << (s.convoy.braking ? 1 : 0);
+  }
+  if (neighbours_) {
+    out_ << ',' << (s.controller.command_projected ? 1 : 0) << ',' << s.controller.constraints_given
+         << ',' << s.controller.constraints_active << ',' << s.controller.constraints_dropped;
   }
   out_ << '\n';
 }

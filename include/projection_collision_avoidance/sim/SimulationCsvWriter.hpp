@@ -29,6 +29,7 @@ class SimulationCsvWriter {
   bool velocities_;
   bool turning_;
   bool path_;
+  bool neighbours_;  // formation.neighbours: the projection's columns
   double xi_max_;
   double xi_soft_;
   double perimeter_;
