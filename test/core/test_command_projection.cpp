@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <cstring>
 #include <limits>
@@ -11,6 +12,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/LU>
 #include <Eigen/QR>
 #include <Eigen/SVD>
 #include <gtest/gtest.h>
@@ -344,6 +346,83 @@ TEST(CommandProjection, HalfSpacesOutsideTheBallAreDropped) {
   EXPECT_MATRIX_NEAR(r.command, Vector3d(std::sqrt(0.75), 0.5, 0), 1e-15);
   EXPECT_EQ(r.active, 1);
   EXPECT_TRUE(r.ball_active);
+}
+
+/// The nearest feasible point of a 2-D problem by brute force: every candidate of the KKT active
+/// sets (u_nom, its radial projection, its foot on each line, each line's points on the circle,
+/// each pair of lines' vertex), the feasible one (within 1e-12) nearest u_nom.
+Vector3d bruteForce2D(const std::vector<HalfSpace>& constraints, const Vector3d& u, double a_max) {
+  std::vector<Vector3d> candidates = {u, u * (a_max / u.norm())};
+  for (std::size_t j = 0; j < constraints.size(); ++j) {
+    const Vector3d g = constraints[j].g / constraints[j].g.norm();
+    const double b = constraints[j].b / constraints[j].g.norm();
+    candidates.push_back(u + (b - g.dot(u)) * g);
+    const Vector3d tangent(-g.y(), g.x(), 0.0);
+    const double r2 = a_max * a_max - b * b;
+    if (r2 >= 0.0) {
+      candidates.push_back(b * g + std::sqrt(r2) * tangent);
+      candidates.push_back(b * g - std::sqrt(r2) * tangent);
+    }
+    for (std::size_t i = 0; i < j; ++i) {
+      Eigen::Matrix2d n;
+      n << constraints[i].g.x(), constraints[i].g.y(), constraints[j].g.x(), constraints[j].g.y();
+      if (std::abs(n.determinant()) > 1e-9) {
+        const Eigen::Vector2d v = n.inverse() * Eigen::Vector2d(constraints[i].b, constraints[j].b);
+        candidates.emplace_back(v.x(), v.y(), 0.0);
+      }
+    }
+  }
+  Vector3d best = Vector3d::Constant(kInf);
+  for (const Vector3d& x : candidates) {
+    bool feasible = x.norm() <= a_max + 1e-12;
+    for (const HalfSpace& c : constraints) {
+      feasible = feasible && inside(c, x) >= -1e-12;
+    }
+    if (feasible && (x - u).norm() < (best - u).norm()) {
+      best = x;
+    }
+  }
+  return best;
+}
+
+// crowd_16_gusts.yaml (world.seed=1, a_max 4, neighbours a_b 1, A_n 3, omega 0.5), follower 2 at
+// t = 24.47 s: the eight half-spaces (priority order, unit normals) and cf_sim's nominal command
+// as passed to project(). One half-space is active, the ball and the others are not (the nearest
+// 2.0e-3 away). reference_sim.py's nominal at that tick differs by 1e-4 (its estimate of the
+// error has diverged from cf_sim's by rounding) and so does its projection; both are exact.
+TEST(CommandProjection, Crowd16Seed1Follower2Tick2447) {
+  const std::vector<HalfSpace> constraints = {
+      h(0.99998424240853134, -0.0056138164055828136, 0, -0.24473087610661359),
+      h(0.50599204899185446, 0.86253814197229839, 0, -0.46853866090088081),
+      h(0.99261807964923732, -0.1212821007134212, 0, -1.725285316884805),
+      h(0.85345844647933222, 0.52116089658864939, 0, -1.7415222055299937),
+      h(0.97719527705853826, 0.21234262524158148, 0, -2.9190460404841869),
+      h(0.93611236489037419, 0.35170106667360429, 0, -2.6187969055747775),
+      h(0.76174546966653678, 0.64787640753658216, 0, -2.9551768169825832),
+      h(0.92661061002951683, -0.37602230968484668, 0, -3.1820344385726318)};
+  const CommandProjection projection = make(2, constraints);
+  struct Case {
+    Vector3d nominal;
+    Vector3d expected;  // by NumPy, enumerating every active set
+  };
+  const Case cases[] = {
+      // cf_sim's nominal
+      {Vector3d(-3.98238068829686, -0.37502540377983523, 0),
+       Vector3d(-0.2469578147939515, -0.39599571243045184, 0)},
+      // reference_sim.py's nominal (its projection, with its half-spaces equal to 2e-14)
+      {Vector3d(-3.9823715131423865, -0.375122821635817, 0),
+       Vector3d(-0.24695836138214433, -0.3960930757095758, 0)},
+  };
+  for (const Case& c : cases) {
+    const CommandProjectionResult r = projection.project(c.nominal, 4.0);
+    EXPECT_MATRIX_NEAR(r.command, c.expected, 1e-12);
+    EXPECT_MATRIX_NEAR(r.command, bruteForce2D(constraints, c.nominal, 4.0), 1e-13);
+    EXPECT_NEAR(inside(constraints[0], r.command), 0.0, 1e-14);
+    EXPECT_EQ(r.dropped, 0);
+    EXPECT_EQ(r.active, 1);
+    EXPECT_FALSE(r.ball_active);
+    EXPECT_TRUE(r.changed);
+  }
 }
 
 }  // namespace
