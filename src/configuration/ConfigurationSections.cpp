@@ -16,15 +16,6 @@
 namespace projection_collision_avoidance::detail {
 namespace {
 
-/// Each number of @p keys that @p section has, into its place.
-void readNumbers(YamlReader& section, std::initializer_list<std::pair<const char*, double*>> keys) {
-  for (const auto& [key, value] : keys) {
-    if (section.has(key)) {
-      *value = section.number(key);
-    }
-  }
-}
-
 /// Sets the entry at path[index..] below @p node. Recurses once per path element of an
 /// override ("a.b.0.c"), so the depth is bounded by the length of a command-line key; the
 /// scenario loader runs at start-up, never in a control step.
@@ -91,6 +82,14 @@ void applyOverride(YAML::Node& root, const std::string& assignment) {
 }
 
 }  // namespace
+
+void readNumbers(YamlReader& section, std::initializer_list<std::pair<const char*, double*>> keys) {
+  for (const auto& [key, value] : keys) {
+    if (section.has(key)) {
+      *value = section.number(key);
+    }
+  }
+}
 
 void applyOverrides(YAML::Node& root, const std::vector<std::string>& overrides) {
   for (const std::string& assignment : overrides) {

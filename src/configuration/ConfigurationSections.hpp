@@ -5,7 +5,9 @@
 /// and the steps around reading a tree (internal to the configuration library; the scenario
 /// library reads the rest of the file with them).
 
+#include <initializer_list>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <yaml-cpp/yaml.h>
@@ -25,6 +27,9 @@ void applyOverrides(YAML::Node& root, const std::vector<std::string>& overrides)
 
 /// The `model` section (double_integrator or linear), checked by validateAgentModel().
 AgentModel readModel(YamlReader& reader);
+
+/// Each number of @p keys that @p section has, into its place; the absent ones keep theirs.
+void readNumbers(YamlReader& section, std::initializer_list<std::pair<const char*, double*>> keys);
 
 /// The `formation` section when present (configured), else one follower ("follower"); each
 /// key's own checks only (FormationSpec::validate() checks it against the model).

@@ -6,25 +6,17 @@
 
 #include "projection_collision_avoidance/core/ParameterError.hpp"
 
+#include "ConfigurationSections.hpp"
+
 namespace projection_collision_avoidance::detail {
 namespace {
-
-/// Each present key of @p keys read as a number into its target.
-void readOptionalNumbers(YamlReader& section,
-                         std::initializer_list<std::pair<const char*, double*>> keys) {
-  for (const auto& [name, target] : keys) {
-    if (section.has(name)) {
-      *target = section.number(name);
-    }
-  }
-}
 
 VehicleSpec readVehicle(YamlReader& parent, const VehicleSpec& defaults) {
   YamlReader section = parent.map("vehicle");
   VehicleSpec vehicle = defaults;
-  readOptionalNumbers(section, {{"acceleration_limit", &vehicle.acceleration_limit},
-                                {"input_gain", &vehicle.input_gain},
-                                {"actuator_lag", &vehicle.actuator_lag}});
+  readNumbers(section, {{"acceleration_limit", &vehicle.acceleration_limit},
+                        {"input_gain", &vehicle.input_gain},
+                        {"actuator_lag", &vehicle.actuator_lag}});
   section.finish();
   return vehicle;
 }
@@ -119,18 +111,17 @@ WorldSpec readWorld(YamlReader& reader, Eigen::Index state_size) {
   if (section.has("gusts")) {
     YamlReader gusts = section.map("gusts");
     GustSpec& g = world.gusts;
-    readOptionalNumbers(gusts, {{"rate", &g.rate},
-                                {"magnitude", &g.magnitude},
-                                {"min_duration", &g.min_duration},
-                                {"max_duration", &g.max_duration},
-                                {"start", &g.start},
-                                {"end", &g.end}});
+    readNumbers(gusts, {{"rate", &g.rate},
+                        {"magnitude", &g.magnitude},
+                        {"min_duration", &g.min_duration},
+                        {"max_duration", &g.max_duration},
+                        {"start", &g.start},
+                        {"end", &g.end}});
     gusts.finish();
   }
   if (section.has("measurement_noise")) {
     YamlReader noise = section.map("measurement_noise");
-    readOptionalNumbers(noise,
-                        {{"position", &world.noise_position}, {"velocity", &world.noise_velocity}});
+    readNumbers(noise, {{"position", &world.noise_position}, {"velocity", &world.noise_velocity}});
     noise.finish();
   }
   section.finish();
