@@ -75,10 +75,17 @@ PlantWorld::PlantWorld(ros::NodeHandle nh, ros::NodeHandle private_nh)
           scenario_.formation.configured ? "~scenario/formation" : "~follower_frame",
           "follower frame '" + frame + "' clashes with the world or leader frame");
     }
+    // The world as cf_sim applies it (nothing without a world section), the true vehicle's lag
+    // sampled at the plant's step: the control period when ~rate is the control rate.
+    FollowerWorld world(scenario_.world, member.index, scenario_.controller.model,
+                        scenario_.duration, 1.0 / options_.rate);
+    const SignalProfile disturbance = world.disturbance();
     followers_.push_back(Follower{
         Agent(member.name, frame, scenario_.controller.model, 1.0 / options_.rate,
-              member.initial_state, SignalProfile{}, options_.command_timeout, options_.clock_skew),
+              member.initial_state, disturbance, options_.command_timeout, options_.clock_skew),
         member.target,
+        {},
+        std::move(world),
         {}});
   }
   attachVehicle(&leader_);
@@ -87,11 +94,23 @@ PlantWorld::PlantWorld(ros::NodeHandle nh, ros::NodeHandle private_nh)
     ROS_WARN_STREAM(name_ << ": the leader is a vehicle kind: leader.disturbance does not act");
   }
   connectAgent(&leader_);
-  for (Follower& follower : followers_) {
+  for (std::size_t i = 0; i < followers_.size(); ++i) {
+    Follower& follower = followers_[i];
     attachVehicle(&follower.agent);
+    if (follower.agent.vehicle && (follower.world.disturbed() || follower.world.hasVehicle())) {
+      ROS_WARN_STREAM(name_ << ": " << follower.agent.name
+                            << " is a vehicle kind: the world's disturbance and true vehicle do "
+                               "not act on it");
+    }
     connectAgent(&follower.agent);
     follower.measurement_publisher.advertise<RelativeMeasurement>(
         nh_, follower.agent.name + "/relative_measurement", 10);
+    if (scenario_.formation.neighbours.enabled) {
+      advertiseNeighbours(static_cast<int>(i));
+    }
+  }
+  if (scenario_.formation.neighbours.enabled) {
+    states_.assign(1 + followers_.size(), Eigen::VectorXd::Zero(2 * axes_));
   }
   marker_publisher_ = nh_.advertise<visualization_msgs::MarkerArray>("agent_markers", 2);
   ticks_per_marker_ = std::max(1L, static_cast<long>(std::ceil(options_.rate / kMarkerRate)));

@@ -12,6 +12,7 @@
 #include <tf2_ros/static_transform_broadcaster.h>
 #include <tf2_ros/transform_broadcaster.h>
 
+#include "projection_collision_avoidance/NeighbourArray.h"
 #include "projection_collision_avoidance/RelativeMeasurement.h"
 #include "projection_collision_avoidance/cycle/InputGuard.hpp"
 #include "projection_collision_avoidance/cycle/InputTimeline.hpp"
@@ -19,6 +20,7 @@
 #include "projection_collision_avoidance/ros/InputAdmission.hpp"
 #include "projection_collision_avoidance/ros/RosParameters.hpp"
 #include "projection_collision_avoidance/sim/AgentIntegrator.hpp"
+#include "projection_collision_avoidance/sim/FollowerWorld.hpp"
 #include "projection_collision_avoidance/sim/MeasurementChannel.hpp"
 #include "projection_collision_avoidance/sim/Scenario.hpp"
 
@@ -49,6 +51,14 @@ namespace projection_collision_avoidance {
 /// `<follower>/applied_command`. With ~lockstep tick k + 1 does that integration instead, once
 /// the commands answering sample k are in (PlantClock holds simulated time until then), so
 /// that every agent integrates [t_k, t_k+1] with its answer to t_k, as cf_sim does.
+///
+/// The scenario's `world` acts as in cf_sim (FollowerWorld): follower i integrates its
+/// disturbance w_i(t) (pulses, sinusoids, gusts drawn over the scenario's duration), each tick's
+/// held command goes through its true vehicle before it is integrated (and is published as
+/// applied_command so), and the world's noise of tick k is added to the relative state sampled
+/// at tick k. With formation.neighbours, each tick also publishes `<follower>/neighbours`
+/// (NeighbourArray: every other agent within formation.neighbours.radius, x_j - x_i exact,
+/// stamped and framed as that tick's relative_measurement).
 ///
 /// An agent listed in ~vehicles with kind `velocity` or `unicycle` is a PlantVehicle instead: it
 /// takes Twists on `<agent>/cmd_vel` (and TwistStamped on `<agent>/cmd_vel_stamped`), publishes
@@ -98,11 +108,23 @@ class PlantWorld {
     }
   };
 
-  /// A follower: its agent, its target and its measurement topic.
+  /// A follower's `neighbours` output, allocated once: each tick moves the entries of the agents
+  /// within the radius into the message and, the tick after, back.
+  struct NeighbourOutput {
+    CountedPublisher publisher;
+    NeighbourArray message;          ///< header set once but its stamp; entries moved in
+    std::vector<Neighbour> entries;  ///< one per other agent: its id, k entries each
+    std::vector<int> agents;         ///< each entry's agent: 0 the leader, j follower j
+    std::vector<std::size_t> taken;  ///< the entry each of message.neighbours came from
+  };
+
+  /// A follower: its agent, its target, its measurement topic, its part of the world.
   struct Follower {
     Agent agent;
     int target = 0;  ///< 0: the leader; j: followers_[j - 1]
     CountedPublisher measurement_publisher;
+    FollowerWorld world;         ///< the scenario's world for it (nothing without a world section)
+    NeighbourOutput neighbours;  ///< with formation.neighbours
   };
 
   /// ~wait_for_subscribers: how many of its topics have a subscriber at the master (queried at
@@ -124,8 +146,13 @@ class PlantWorld {
   bool tick(long k);
   /// Samples follower @p index's channel at tick k and publishes what is due.
   void publishMeasurement(int index, long k);
-  /// Publishes the command the agent's tick k at time t (s) integrates, and integrates it.
-  void advanceAgent(Agent* agent, double t, const ros::Time& stamp);
+  /// Sets up follower @p index's `neighbours` output (formation.neighbours).
+  void advertiseNeighbours(int index);
+  /// Publishes follower @p index's sensed agents at @p stamp (states_ filled this tick).
+  void publishNeighbours(int index, const ros::Time& stamp);
+  /// Publishes the command the agent's tick k at time t (s) integrates, and integrates it; a
+  /// follower's through its true vehicle (@p world; null for the leader).
+  void advanceAgent(Agent* agent, double t, const ros::Time& stamp, FollowerWorld* world = nullptr);
   /// Integrates every agent over [t_k, t_k+1] with its command held; the leader under u_d.
   void advanceAll(long k);
   /// Lockstep: whether every agent that has commanded and still has a sender answered sample k:
@@ -158,6 +185,8 @@ class PlantWorld {
   Agent leader_;
   std::vector<Follower> followers_;  ///< in index order; never resized after the subscriptions
   std::unique_ptr<MeasurementChannels> channels_;
+  /// With formation.neighbours: every agent's state this tick (0 the leader, j follower j).
+  std::vector<Eigen::VectorXd> states_;
   long ticks_per_marker_ = 1;
   long last_tick_ = -1;  ///< tick at the duration; -1 = run forever
 

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <string>
+#include <utility>
 
 #include <geometry_msgs/TransformStamped.h>
 #include <nav_msgs/Odometry.h>
@@ -31,6 +33,22 @@ bool PlantWorld::tick(long k) {
   for (std::size_t i = 0; i < followers_.size(); ++i) {
     sampleAgent(&followers_[i].agent, stamp, &transforms);
     publishMeasurement(static_cast<int>(i), k);
+  }
+  if (!states_.empty()) {  // formation.neighbours: each follower's sensed agents
+    const auto store = [](const Agent& agent, Eigen::VectorXd* state) {
+      if (agent.vehicle) {
+        *state = agent.vehicle->state();
+      } else {
+        *state = agent.integrator.state();  // into the vector of last tick: no allocation
+      }
+    };
+    store(leader_, &states_[0]);
+    for (std::size_t i = 0; i < followers_.size(); ++i) {
+      store(followers_[i].agent, &states_[i + 1]);
+    }
+    for (std::size_t i = 0; i < followers_.size(); ++i) {
+      publishNeighbours(static_cast<int>(i), stamp);
+    }
   }
   tf_broadcaster_.sendTransform(transforms);
   if (k % ticks_per_marker_ == 0) {
@@ -75,7 +93,7 @@ void PlantWorld::advanceAll(long k) {
   const ros::Time stamp = clock_->stampOf(k);
   advanceAgent(&leader_, t, stamp);
   for (Follower& follower : followers_) {
-    advanceAgent(&follower.agent, t, stamp);
+    advanceAgent(&follower.agent, t, stamp, &follower.world);
   }
 }
 
@@ -114,12 +132,16 @@ bool PlantWorld::everyAgentCommanded() const {
                      [&](const Follower& follower) { return commanded(follower.agent); });
 }
 
-void PlantWorld::advanceAgent(Agent* agent, double t, const ros::Time& stamp) {
+void PlantWorld::advanceAgent(Agent* agent, double t, const ros::Time& stamp,
+                              FollowerWorld* world) {
   if (agent->vehicle) {
     agent->vehicle->advance(1.0 / options_.rate, stamp);
     return;
   }
-  const GenericDimensions::InputVector command = commandAt(agent, stamp);
+  GenericDimensions::InputVector command = commandAt(agent, stamp);
+  if (world != nullptr && world->hasVehicle()) {
+    command = world->apply(command);  // g z_k of its true vehicle, as SampledSimulator applies it
+  }
   if (agent->applied_command_publisher.subscribed()) {
     agent->applied_command_publisher.publish(
         boost::make_shared<geometry_msgs::AccelStamped>(toAccelMsg(command, stamp, agent->frame)));
@@ -129,7 +151,8 @@ void PlantWorld::advanceAgent(Agent* agent, double t, const ros::Time& stamp) {
 
 void PlantWorld::publishMeasurement(int index, long k) {
   Follower& follower = followers_[static_cast<std::size_t>(index)];
-  const Eigen::VectorXd relative = targetOf(follower).state() - follower.agent.state();
+  Eigen::VectorXd relative = targetOf(follower).state() - follower.agent.state();
+  follower.world.addNoise(k, &relative);  // the world's noise of the plant's tick k
   const double t = static_cast<double>(k) / options_.rate;
   switch (channels_->sample(index, k, relative)) {
     case OutageChange::kBegan:
@@ -150,6 +173,59 @@ void PlantWorld::publishMeasurement(int index, long k) {
     follower.measurement_publisher.publish(boost::make_shared<RelativeMeasurement>(
         toRelativeMeasurementMsg(measured, clock_->stampOf(sampled), options_.world_frame)));
   }
+}
+
+void PlantWorld::advertiseNeighbours(int index) {
+  Follower& follower = followers_[static_cast<std::size_t>(index)];
+  NeighbourOutput& output = follower.neighbours;
+  const std::size_t others = followers_.size();  // the leader and every other follower
+  const auto entry = [this](const std::string& id) {
+    Neighbour neighbour;
+    neighbour.id = id;
+    neighbour.position.assign(static_cast<std::size_t>(axes_), 0.0);
+    neighbour.velocity.assign(static_cast<std::size_t>(axes_), 0.0);
+    return neighbour;
+  };
+  output.entries.reserve(others);
+  output.agents.reserve(others);
+  output.entries.push_back(entry(leader_.name));
+  output.agents.push_back(0);
+  for (std::size_t j = 0; j < followers_.size(); ++j) {
+    if (static_cast<int>(j) != index) {
+      output.entries.push_back(entry(followers_[j].agent.name));
+      output.agents.push_back(static_cast<int>(j) + 1);
+    }
+  }
+  output.taken.assign(others, 0);
+  output.message.neighbours.reserve(others);
+  output.message.header.frame_id = options_.world_frame;  // relative_measurement's frame
+  output.publisher.advertise<NeighbourArray>(nh_, follower.agent.name + "/neighbours", 10);
+}
+
+void PlantWorld::publishNeighbours(int index, const ros::Time& stamp) {
+  Follower& follower = followers_[static_cast<std::size_t>(index)];
+  NeighbourOutput& output = follower.neighbours;
+  if (!output.publisher.subscribed()) {
+    return;
+  }
+  // Last tick's entries back to their places (moves: no allocation), then this tick's sensed.
+  std::vector<Neighbour>& sensed = output.message.neighbours;
+  for (std::size_t e = 0; e < sensed.size(); ++e) {
+    output.entries[output.taken[e]] = std::move(sensed[e]);
+  }
+  sensed.clear();
+  const Eigen::VectorXd& own = states_[static_cast<std::size_t>(index) + 1];
+  const double radius = scenario_.formation.neighbours.radius;
+  for (std::size_t s = 0; s < output.entries.size(); ++s) {
+    Neighbour& entry = output.entries[s];
+    const Eigen::VectorXd& other = states_[static_cast<std::size_t>(output.agents[s])];
+    if (relativeStateWithin(own, other, axes_, radius, &entry.position, &entry.velocity)) {
+      output.taken[sensed.size()] = s;
+      sensed.push_back(std::move(entry));
+    }
+  }
+  output.message.header.stamp = stamp;
+  output.publisher.publish(output.message);  // serialised now: the message stays ours
 }
 
 const PlantWorld::Agent& PlantWorld::targetOf(const Follower& follower) const {
