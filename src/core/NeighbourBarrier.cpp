@@ -90,6 +90,7 @@ NeighbourConstraints::NeighbourConstraints(const NeighbourParameters& parameters
 
 void NeighbourConstraints::clear() {
   count_ = 0;
+  added_ = 0;
   sensed_ = 0;
   rejected_ = 0;
   nearest_ = std::numeric_limits<double>::infinity();
@@ -97,6 +98,7 @@ void NeighbourConstraints::clear() {
 
 void NeighbourConstraints::add(const Eigen::Vector3d& relative_position,
                                const Eigen::Vector3d& relative_velocity, double perimeter) {
+  const int source = added_++;
   const int k = projection_.dimension();
   Eigen::Vector3d p = Eigen::Vector3d::Zero();
   Eigen::Vector3d v = Eigen::Vector3d::Zero();
@@ -112,7 +114,8 @@ void NeighbourConstraints::add(const Eigen::Vector3d& relative_position,
   }
   ++sensed_;
   nearest_ = std::min(nearest_, distance);
-  const NeighbourConstraint constraint = neighbourBarrier(p, v, parameters_, perimeter);
+  NeighbourConstraint constraint = neighbourBarrier(p, v, parameters_, perimeter);
+  constraint.source = source;
   if (!(constraint.bound > -acceleration_limit_) || !std::isfinite(constraint.bound)) {
     return;  // no command within the limit violates it (or it overflowed: not kept)
   }

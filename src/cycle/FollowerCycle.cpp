@@ -51,6 +51,11 @@ FollowerCycle::FollowerCycle(std::unique_ptr<DynamicFollowerController> controll
         *settings_.path, period_, separation_,
         static_cast<int>(handover_.current().design().parameters.model.position_dimension));
   }
+  if (settings_.neighbours) {
+    const ControllerParameters& p = handover_.current().design().parameters;
+    neighbours_.emplace(*settings_.neighbours, static_cast<int>(p.model.position_dimension),
+                        p.acceleration_limit);
+  }
 }
 
 FollowerCycle::~FollowerCycle() = default;
@@ -138,6 +143,7 @@ bool FollowerCycle::step(std::int64_t now_ns, std::int64_t stamp_ns, double dela
   const std::int64_t stamp =
       have_stamp_ && stamp_ns <= last_stamp_ns_ ? last_stamp_ns_ + 1 : stamp_ns;
   DynamicStepInputs inputs;  // without a measurement the step runs the fallback
+  inputs.command_constraints = constrainByNeighbours(stamp_ns, design.perimeter, out);
   if (settings_.measurement_trigger && have_stamp_) {
     inputs.period_fraction =
         std::min(1.0, kNanosecond * static_cast<double>(stamp - last_stamp_ns_) / period_);
@@ -164,8 +170,34 @@ bool FollowerCycle::step(std::int64_t now_ns, std::int64_t stamp_ns, double dela
   out->measurement_age = ages.measurement_age;
   out->leader_age = ages.leader_age;
   out->status = *status;
+  if (neighbours_ && inputs.command_constraints) {
+    neighbours_->report(inputs_.neighbours(), *status, &out->neighbours);
+  }
   fillCounters(now_ns, out);
   return true;
+}
+
+const CommandProjection* FollowerCycle::constrainByNeighbours(std::int64_t stamp_ns,
+                                                              double target_perimeter,
+                                                              FollowerCycleOutput* out) {
+  NeighbourReport& report = out->neighbours;
+  report = NeighbourReport{};
+  if (!neighbours_) {
+    return nullptr;
+  }
+  report.configured = true;
+  report.age = inputs_.neighboursAge(stamp_ns);
+  report.fresh = report.age <= settings_.measurement_timeout;
+  if (!report.fresh) {  // where the others are is not known: brake
+    mode_ = FollowerMode::kMeasurementLost;
+    out->mode = mode_;
+    report.nearest = std::numeric_limits<double>::infinity();
+    report.smallest_barrier = std::numeric_limits<double>::infinity();
+    return nullptr;
+  }
+  const NeighbourSample& sample = inputs_.neighbours();
+  const double ahead = kNanosecond * static_cast<double>(stamp_ns - sample.stamp_ns);
+  return &neighbours_->constrain(sample, ahead, settings_.measurement_timeout, target_perimeter);
 }
 
 bool FollowerCycle::turnSlot(std::int64_t stamp_ns, const GenericDimensions::StateVector& state,

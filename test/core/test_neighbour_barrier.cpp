@@ -115,6 +115,9 @@ TEST(NeighbourConstraints, KeepTheMostUrgentWithinTheRadiusAndCapacity) {
   // the leaving one asks nothing a limited command could violate (b <= -a_max) and is left out;
   // the inside one comes first, then the closing one
   ASSERT_EQ(constraints.kept(), 2);
+  EXPECT_EQ(constraints.constraint(0).source, 2);  // the third add(): inside
+  EXPECT_EQ(constraints.constraint(1).source, 0);  // the first: closing
+  EXPECT_DOUBLE_EQ(constraints.constraint(0).distance, 0.5);
   const CommandProjection& projection = constraints.projection();
   ASSERT_EQ(projection.size(), 2);
   const CommandProjectionResult result = projection.project(Eigen::Vector3d::Zero(), 4.0);
@@ -123,6 +126,9 @@ TEST(NeighbourConstraints, KeepTheMostUrgentWithinTheRadiusAndCapacity) {
   constraints.clear();
   EXPECT_EQ(constraints.kept(), 0);
   EXPECT_EQ(constraints.projection().size(), 0);
+  constraints.add(Eigen::Vector3d(0.5, 0.0, 0.0), still);  // the sources count afresh
+  ASSERT_EQ(constraints.kept(), 1);
+  EXPECT_EQ(constraints.constraint(0).source, 0);
 }
 
 TEST(NeighbourParameters, EachBadValueIsRefusedByName) {

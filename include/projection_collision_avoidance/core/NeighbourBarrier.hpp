@@ -42,6 +42,9 @@ struct NeighbourConstraint {
   double bound = 0.0;                                ///< b (m/s^2)
   double barrier = 0.0;   ///< h (m/s), (N1); -infinity inside the perimeter
   double distance = 0.0;  ///< c = ||p_i - p_j|| (m)
+  /// Which neighbour it is: the number of NeighbourConstraints::add() calls before its own since
+  /// clear() (0-based); -1 from neighbourBarrier() alone.
+  int source = -1;
 };
 
 /// (N1)-(N2): the barrier of follower i against neighbour j and the half-space it puts its
@@ -81,6 +84,8 @@ class NeighbourConstraints {
            double perimeter);
   /// The half-spaces of the kept neighbours in priority order.
   const CommandProjection& projection();
+  /// Kept constraint @p j, 0 <= j < kept(), in priority order (most urgent first).
+  const NeighbourConstraint& constraint(int j) const { return kept_[static_cast<std::size_t>(j)]; }
 
   int sensed() const { return sensed_; }      ///< neighbours within the radius this tick
   int kept() const { return count_; }         ///< of them, constraining (at most max_neighbours)
@@ -99,6 +104,7 @@ class NeighbourConstraints {
   std::array<NeighbourConstraint, kCapacity> kept_;  // sorted, most urgent first
   CommandProjection projection_;
   int count_ = 0;
+  int added_ = 0;  // add() calls since clear()
   int sensed_ = 0;
   int rejected_ = 0;
   double nearest_ = std::numeric_limits<double>::infinity();

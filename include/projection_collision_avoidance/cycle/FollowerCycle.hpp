@@ -16,6 +16,7 @@
 #include "projection_collision_avoidance/cycle/ControllerHandover.hpp"
 #include "projection_collision_avoidance/cycle/InputTimeline.hpp"
 #include "projection_collision_avoidance/cycle/LatchedInputs.hpp"
+#include "projection_collision_avoidance/cycle/NeighbourSensing.hpp"
 #include "projection_collision_avoidance/cycle/PathSlot.hpp"
 #include "projection_collision_avoidance/cycle/StallWait.hpp"
 #include "projection_collision_avoidance/cycle/StepPacer.hpp"
@@ -41,6 +42,9 @@ struct FollowerCycleSettings {
   std::optional<SlotHeadingParameters> turning;
   /// Path slots (formation.slots: path): the convoy's reference (C1)-(C5); empty: no convoy.
   std::optional<ConvoyParameters> path;
+  /// formation.neighbours: every step keeps out of the agents of the latest neighbour array
+  /// (N1)-(N3), which is stale after measurement_timeout; empty: the target alone.
+  std::optional<NeighbourCycleSettings> neighbours;
 };
 
 /// What a tick or step gives the outputs: the step's results when one ran, and the counters.
@@ -89,6 +93,7 @@ struct FollowerCycleOutput {
   std::uint32_t time_jumps = 0;  ///< jumps back of ROS time since start
   double time_jump = 0.0;        ///< s (negative): the jump seen at this tick, else 0
   double stall = 0.0;            ///< s: a tick this late began a wait for input, else 0
+  NeighbourReport neighbours;    ///< formation.neighbours: what the sensed agents did
 };
 
 /// The follower's control cycle without ROS: it reads the latest accepted inputs from lock-free
@@ -101,7 +106,10 @@ struct FollowerCycleOutput {
 /// step waits for the own state, which sets theta(0). With path slots (FollowerCycleSettings::path)
 /// the slot is a reference point on the target's path, the target's state being the own
 /// (odometry) plus the measured relative state (PathSlot); the first step waits for the own
-/// state, and a step without a fresh own state brakes (mode measurement_lost). Nothing in tick() or
+/// state, and a step without a fresh own state brakes (mode measurement_lost). With
+/// formation.neighbours (FollowerCycleSettings::neighbours) every step's command keeps out of the
+/// agents of the latest neighbour array (NeighbourSensing, (N1)-(N3)); a step without one younger
+/// than the measurement timeout brakes (mode measurement_lost). Nothing in tick() or
 /// stepOnMeasurement() allocates, locks (except under the measurement trigger, whose steps run in
 /// the measurement's callback, and a tick waits for a step running there) or makes a system call,
 /// so that a real-time thread can run it.
@@ -132,6 +140,8 @@ class FollowerCycle {
   LatestValue<LeaderSample>& leader() { return inputs_.leaderSlot(); }
   /// The slot the own odometry's callback writes (one writer thread; time headway only).
   LatestValue<OwnStateSample>& ownState() { return inputs_.ownStateSlot(); }
+  /// The slot the neighbour array's callback writes (one writer thread; formation.neighbours).
+  LatestValue<NeighbourSample>& neighbours() { return inputs_.neighbourSlot(); }
 
   /// A tick of the fixed-rate loop at steady (monotonic) time @p steady_ns, @p delay s after it
   /// was due, with @p skipped periods skipped before it. It latches the inputs first and then
@@ -229,6 +239,11 @@ class FollowerCycle {
   /// A step without a fresh own state is one of mode measurement_lost.
   bool pathSlot(std::int64_t stamp_ns, const GenericDimensions::StateVector& state,
                 FollowerCycleOutput* out);
+  /// formation.neighbours: the half-spaces of the step stamped @p stamp_ns from the latest
+  /// neighbour array, the target's perimeter @p target_perimeter (m); nullptr without the
+  /// section, and when that array is stale (the step then brakes: mode measurement_lost).
+  const CommandProjection* constrainByNeighbours(std::int64_t stamp_ns, double target_perimeter,
+                                                 FollowerCycleOutput* out);
   /// The counters and the design in force into @p out (whether or not a step ran).
   void fillCounters(std::int64_t now_ns, FollowerCycleOutput* out) const;
   /// Notes ROS time @p now_ns: a jump back is counted, and the stamps start afresh.
@@ -240,6 +255,7 @@ class FollowerCycle {
   std::optional<SlotHeading> slot_heading_;           ///< theta (T1) of a turning slot
   bool heading_started_ = false;                      ///< theta(0) set by the first step
   std::optional<PathSlot> path_slot_;                 ///< r (C1)-(C5) of a path slot
+  std::optional<NeighbourSensing> neighbours_;        ///< (N1)-(N3) with formation.neighbours
   GenericDimensions::InputVector slot_acceleration_;  ///< u_r (T3) of the step
   double period_ = 0.0;
   std::mutex trigger_mutex_;  ///< measurement trigger only: callback steps vs braking ticks
