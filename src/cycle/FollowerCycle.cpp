@@ -116,7 +116,9 @@ bool FollowerCycle::step(std::int64_t now_ns, std::int64_t stamp_ns, double dela
   out->stepped = false;
   out->mode = mode_;
   const GenericDimensions::StateVector& state = inputs_.measurement().relative_state;
-  if (mode_ == FollowerMode::kWaiting || !turnSlot(stamp_ns, state, out)) {
+  // The first step waits for the first neighbour array too (formation.neighbours).
+  const bool neighbours_unknown = neighbours_ && !inputs_.everNeighboured();
+  if (mode_ == FollowerMode::kWaiting || neighbours_unknown || !turnSlot(stamp_ns, state, out)) {
     mode_ = FollowerMode::kWaiting;
     out->mode = mode_;
     fillCounters(now_ns, out);

@@ -1,6 +1,7 @@
 #include "projection_collision_avoidance/ros/MessageConversions.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include <Eigen/Geometry>
 #include <tf2_eigen/tf2_eigen.h>
@@ -64,6 +65,64 @@ bool leaderInputFromMsg(const LeaderBroadcast& msg, int axes, Eigen::VectorXd* i
   }
   *input = toEigen(msg.input);
   *disturbance = toEigen(msg.disturbance);
+  return true;
+}
+
+bool neighbourSampleFromMsg(const NeighbourArray& msg, int axes, const std::string& self,
+                            const std::string& target, NeighbourSample* sample,
+                            std::vector<std::pair<double, std::size_t>>* order, std::string* why) {
+  const std::size_t entries = msg.neighbours.size();
+  if (entries > kMaxNeighbourEntries) {
+    *why =
+        std::to_string(entries) + " neighbours, more than " + std::to_string(kMaxNeighbourEntries);
+    return false;
+  }
+  const auto axes_entries = static_cast<std::size_t>(axes);
+  order->clear();
+  for (std::size_t e = 0; e < entries; ++e) {
+    const Neighbour& entry = msg.neighbours[e];
+    if (entry.position.size() != axes_entries || entry.velocity.size() != axes_entries) {
+      *why = "neighbour " + std::to_string(e) + ": position and velocity must have " +
+             std::to_string(axes) + " entries, got " + std::to_string(entry.position.size()) +
+             " and " + std::to_string(entry.velocity.size());
+      return false;
+    }
+    double squared = 0.0;
+    bool finite = true;
+    for (std::size_t a = 0; a < axes_entries; ++a) {
+      squared += entry.position[a] * entry.position[a];
+      finite = finite && std::isfinite(entry.position[a]) && std::isfinite(entry.velocity[a]);
+    }
+    if (!finite || !std::isfinite(squared)) {
+      *why = "neighbour " + std::to_string(e) + ": non-finite entry";
+      return false;
+    }
+    if (entry.id == self) {
+      *why = "neighbour " + std::to_string(e) + " is the follower itself (id " + self + ")";
+      return false;
+    }
+    order->emplace_back(squared, e);
+  }
+  // The nearest first; ties by their place in the message.
+  const std::size_t kept = std::min<std::size_t>(entries, NeighbourSample::kCapacity);
+  std::partial_sort(order->begin(), order->begin() + static_cast<std::ptrdiff_t>(kept),
+                    order->end());
+  for (std::size_t j = 0; j < kept; ++j) {
+    const Neighbour& entry = msg.neighbours[(*order)[j].second];
+    SensedAgent& agent = sample->agents[j];
+    agent.position.setZero();
+    agent.velocity.setZero();
+    for (std::size_t a = 0; a < axes_entries; ++a) {
+      agent.position(static_cast<Eigen::Index>(a)) = entry.position[a];
+      agent.velocity(static_cast<Eigen::Index>(a)) = entry.velocity[a];
+    }
+    agent.target = entry.id == target;
+    const std::size_t length = std::min(entry.id.size(), SensedAgent::kIdLength - 1);
+    std::copy_n(entry.id.data(), length, agent.id.data());
+    agent.id[length] = '\0';
+  }
+  sample->count = static_cast<int>(kept);
+  sample->sent = static_cast<int>(entries);
   return true;
 }
 

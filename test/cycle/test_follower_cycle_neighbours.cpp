@@ -1,8 +1,8 @@
 /// The follower's control cycle with formation.neighbours (doc/math.md, "Neighbours"), without
-/// ROS: a step without a fresh neighbour array brakes; with one, the command is the paper's
-/// projected onto the agents' half-spaces (N3), each agent moved to the step's stamp and given its
-/// perimeter (the target's alpha ||d_i||, the others' rho); the report says which agent acts; a
-/// step with 64 agents allocates nothing.
+/// ROS: the first step waits for a neighbour array, a step without a fresh one brakes; with one,
+/// the command is the paper's projected onto the agents' half-spaces (N3), each agent moved to the
+/// step's stamp and given its perimeter (the target's alpha ||d_i||, the others' rho); the report
+/// says which agent acts; a step with 64 agents allocates nothing.
 
 #include <cmath>
 #include <cstdint>
@@ -83,16 +83,12 @@ NeighbourSample crowdAt(std::int64_t stamp_ns, std::uint64_t sequence) {
   return sample;
 }
 
-TEST(FollowerCycleNeighbours, WithoutAFreshArrayTheStepBrakes) {
+TEST(FollowerCycleNeighbours, TheFirstStepWaitsForAnArrayAndAStaleOneBrakes) {
   auto cycle = makeCycle(true);
   FollowerCycleOutput out;
   cycle->measurement().write(measurementAt(kStart, 1));
-  ASSERT_TRUE(cycle->tick(kStart, 0.0, 0, &out));
-  EXPECT_EQ(out.mode, FollowerMode::kMeasurementLost);  // none yet
-  EXPECT_TRUE(out.neighbours.configured);
-  EXPECT_FALSE(out.neighbours.fresh);
-  EXPECT_EQ(out.neighbours.age, kNoInputAge);
-  EXPECT_TRUE(out.status.fallback);
+  EXPECT_FALSE(cycle->tick(kStart, 0.0, 0, &out));  // the first step waits for an array
+  EXPECT_EQ(out.mode, FollowerMode::kWaiting);
 
   const std::int64_t t1 = kStart + 10 * kMs;
   cycle->measurement().write(measurementAt(t1, 2));
@@ -110,6 +106,18 @@ TEST(FollowerCycleNeighbours, WithoutAFreshArrayTheStepBrakes) {
   EXPECT_FALSE(out.neighbours.fresh);
   EXPECT_NEAR(out.neighbours.age, 0.51, 1e-9);
   EXPECT_EQ(out.neighbours.kept, 0);
+  EXPECT_TRUE(out.status.fallback);
+
+  // After a jump back of ROS time the old array is of another timeline: none, so brake.
+  const std::int64_t t3 = t1 - 100 * kMs;
+  cycle->measurement().write(measurementAt(t3, 4));
+  ASSERT_TRUE(cycle->tick(t3, 0.0, 0, &out));
+  EXPECT_EQ(out.mode, FollowerMode::kMeasurementLost);
+  EXPECT_EQ(out.neighbours.age, kNoInputAge);
+  cycle->neighbours().write(crowdAt(t3 + 10 * kMs, 2));
+  cycle->measurement().write(measurementAt(t3 + 10 * kMs, 5));
+  ASSERT_TRUE(cycle->tick(t3 + 10 * kMs, 0.0, 0, &out));
+  EXPECT_EQ(out.mode, FollowerMode::kTracking);
 }
 
 TEST(FollowerCycleNeighbours, TheCommandIsThePapersProjectedOntoTheAgentsHalfSpaces) {

@@ -17,7 +17,9 @@
 ///                    follower's stamps are on its own host's clock
 /// Every follower must report its own place (formation index, target), hear its target's
 /// broadcast, keep ||xi_hat|| within its xi_max, and keep its target outside its perimeter by the
-/// plant's odometry.
+/// plant's odometry; the smallest distance over the pairs of which neither looks at the other
+/// (the plant's odometry) must be cf_sim's within ~tolerance; with formation.neighbours every
+/// follower must report a fresh neighbour array holding every other agent, none refused.
 
 #include <cmath>
 #include <cstddef>
@@ -117,6 +119,25 @@ class FormationTest : public testing::RosTestFixture {
     }
     return {smallest, ticks};
   }
+  /// min ||p_a - p_b|| over the pairs of which neither looks at the other, at the plant ticks
+  /// at which both odometries arrived (m; infinity: no such pair).
+  double trueMinNeighbourSeparation() const {
+    double smallest = std::numeric_limits<double>::infinity();
+    for (std::size_t a = 0; a < agents_.size(); ++a) {
+      for (std::size_t b = a + 1; b < agents_.size(); ++b) {
+        if (agents_[b].target == static_cast<int>(a) || agents_[a].target == static_cast<int>(b)) {
+          continue;  // leader and follower of each other: the paper's pair
+        }
+        for (const auto& [stamp, position] : agents_[a].positions) {
+          const auto match = agents_[b].positions.find(stamp);
+          if (match != agents_[b].positions.end()) {
+            smallest = std::min(smallest, (match->second - position).norm());
+          }
+        }
+      }
+    }
+    return smallest;
+  }
   std::vector<AgentRecord> agents_;
 
  private:
@@ -194,11 +215,25 @@ TEST_F(FormationTest, EveryFollowerHoldsItsSlotAsCfSimDoes) {
     if (xi_bounded) {
       EXPECT_LE(agent.status.max_xi, design.xi_max);
     }
+    if (scenario.formation.neighbours.enabled) {  // every agent of its neighbours array kept
+      EXPECT_TRUE(agent.status.last.neighbours_configured);
+      EXPECT_TRUE(agent.status.last.neighbours_fresh);
+      EXPECT_EQ(agent.status.last.rejected_neighbours, 0U);
+      EXPECT_EQ(agent.status.last.neighbours_sent, members_.size());
+    }
     if (peak_ratio_limit > 0.0 && member.target > 0) {
       const double target_peak = agents_[static_cast<std::size_t>(member.target)].status.max_xi;
       EXPECT_LE(agent.status.max_xi, peak_ratio_limit * target_peak)
           << "peak ratio " << agent.status.max_xi / target_peak;
     }
+  }
+  // Every pair of agents of which neither looks at the other, by the plant's odometry, as cf_sim
+  // has it: without formation.neighbours unprotected, with it kept apart.
+  const double neighbour_separation = trueMinNeighbourSeparation();
+  ROS_INFO("neighbour pairs: ROS min separation %.4f, cf_sim %.4f (rho %.4f)", neighbour_separation,
+           expected.min_neighbour_separation, expected.perimeter);
+  if (std::isfinite(expected.min_neighbour_separation) && first_out_of_bound <= 0) {
+    EXPECT_NEAR(neighbour_separation, expected.min_neighbour_separation, tolerance);
   }
 }
 

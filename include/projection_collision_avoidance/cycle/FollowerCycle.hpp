@@ -108,8 +108,9 @@ struct FollowerCycleOutput {
 /// (odometry) plus the measured relative state (PathSlot); the first step waits for the own
 /// state, and a step without a fresh own state brakes (mode measurement_lost). With
 /// formation.neighbours (FollowerCycleSettings::neighbours) every step's command keeps out of the
-/// agents of the latest neighbour array (NeighbourSensing, (N1)-(N3)); a step without one younger
-/// than the measurement timeout brakes (mode measurement_lost). Nothing in tick() or
+/// agents of the latest neighbour array (NeighbourSensing, (N1)-(N3)): the first step waits for
+/// one, and a step without one younger than the measurement timeout brakes (mode
+/// measurement_lost). Nothing in tick() or
 /// stepOnMeasurement() allocates, locks (except under the measurement trigger, whose steps run in
 /// the measurement's callback, and a tick waits for a step running there) or makes a system call,
 /// so that a real-time thread can run it.

@@ -103,6 +103,7 @@ class LatchedInputs {
   bool everLed() const { return ever_led_; }
   bool haveOwnState() const { return have_own_state_; }
   bool haveNeighbours() const { return have_neighbours_; }
+  bool everNeighboured() const { return ever_neighbours_; }
 
   /// Ages (s) at @p at_ns of the latched measurement / leader broadcast / own state / neighbours
   /// (inputAge()); kNoInputAge when none is valid on this timeline.

@@ -4,7 +4,9 @@
 /// Conversions between the core's Eigen vectors and ROS messages, as free functions. Agents are
 /// double integrators in k = 1..3 axes: state [p; v], positions along x, y, z in that order.
 
+#include <cstddef>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -15,7 +17,9 @@
 #include <visualization_msgs/Marker.h>
 
 #include "projection_collision_avoidance/LeaderBroadcast.h"
+#include "projection_collision_avoidance/NeighbourArray.h"
 #include "projection_collision_avoidance/RelativeMeasurement.h"
+#include "projection_collision_avoidance/cycle/LatchedInputs.hpp"
 #include "projection_collision_avoidance/vehicle/RelativeStateFromOdometry.hpp"
 
 namespace projection_collision_avoidance {
@@ -42,6 +46,19 @@ bool relativeStateFromMsg(const RelativeMeasurement& msg, int axes, Eigen::Vecto
 /// @return false, with the reason in @p why, otherwise
 bool leaderInputFromMsg(const LeaderBroadcast& msg, int axes, Eigen::VectorXd* input,
                         Eigen::VectorXd* disturbance, std::string* why);
+
+/// Most entries a NeighbourArray may hold; a longer one is refused whole.
+inline constexpr std::size_t kMaxNeighbourEntries = 1024;
+
+/// The nearest NeighbourSample::kCapacity agents of a NeighbourArray into @p sample (agents,
+/// count, sent; nearest first; the stamps are the caller's), after checking the whole message:
+/// at most kMaxNeighbourEntries entries, each with @p axes entries of position and velocity, all
+/// finite, none named @p self (the follower itself). The entry named @p target is marked as the
+/// follower's target. @p order is scratch space (reserved once: no allocation after).
+/// @return false, with the reason in @p why, otherwise (@p sample then unchanged)
+bool neighbourSampleFromMsg(const NeighbourArray& msg, int axes, const std::string& self,
+                            const std::string& target, NeighbourSample* sample,
+                            std::vector<std::pair<double, std::size_t>>* order, std::string* why);
 
 /// A RelativeMeasurement of the relative state [position; velocity] (2 axes entries).
 RelativeMeasurement toRelativeMeasurementMsg(const Eigen::Ref<const Eigen::VectorXd>& state,

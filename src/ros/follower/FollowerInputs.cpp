@@ -36,6 +36,9 @@ FollowerInputs::FollowerInputs(std::string node_name, const FollowerNodeOptions&
   own_state_.controlled_position.setZero(axes_);
   relative_state_ = Eigen::VectorXd::Zero(2 * axes_);
   odometry_state_ = Eigen::VectorXd::Zero(2 * axes_);
+  if (options.neighbours) {
+    neighbours_ = std::make_unique<NeighbourInput>(name_, options, axes_, &cycle->neighbours());
+  }
 }
 
 void FollowerInputs::start(ros::NodeHandle node) {
@@ -57,6 +60,9 @@ void FollowerInputs::start(ros::NodeHandle node) {
     odometry_subscriber_ = nh.subscribe("odom", 10, &FollowerInputs::onOdometry, this,
                                         ros::TransportHints().tcpNoDelay());
   }
+  if (neighbours_) {
+    neighbours_->start(nh, link);
+  }
 }
 
 FollowerInputStats FollowerInputs::stats(std::int64_t now_ns) const {
@@ -70,8 +76,18 @@ FollowerInputStats FollowerInputs::stats(std::int64_t now_ns) const {
   stats.measurement_skew = measurement_timeline_.skew();
   stats.leader_skew = leader_timeline_.skew();
   stats.clock_offset = clock_offset_.load(std::memory_order_relaxed);
+  if (neighbours_) {
+    const InputTimeline& timeline = neighbours_->timeline();
+    stats.rejected_neighbours = timeline.rejected();
+    stats.neighbours_age = timeline.age(now_ns);
+    stats.neighbour_rejection = neighbours_->rejection();
+  }
   for (const InputTimeline* timeline :
-       {&measurement_timeline_, &leader_timeline_, &odometry_timeline_}) {
+       {&measurement_timeline_, &leader_timeline_, &odometry_timeline_,
+        neighbours_ ? &neighbours_->timeline() : nullptr}) {
+    if (timeline == nullptr) {
+      continue;
+    }
     stats.foreign_messages += timeline->foreignMessages();
     stats.foreign_heard_ns = std::max(stats.foreign_heard_ns, timeline->foreignHeard());
     stats.input_restarts += timeline->restarts();

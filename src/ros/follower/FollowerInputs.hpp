@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <mutex>
 #include <string>
 
@@ -22,6 +23,7 @@
 
 #include "follower/FollowerOptions.hpp"
 #include "follower/MeasurementAdapter.hpp"
+#include "follower/NeighbourInput.hpp"
 
 namespace projection_collision_avoidance {
 
@@ -55,6 +57,10 @@ struct FollowerInputStats {
   /// passed to another publisher after its holder went quiet
   std::uint64_t input_restarts = 0;
   std::uint64_t input_handovers = 0;
+  /// formation.neighbours: arrays refused, the latest reason, the age of the latest accepted
+  std::uint64_t rejected_neighbours = 0;
+  std::string neighbour_rejection;
+  double neighbours_age = kNoInputAge;
 };
 
 /// The follower's inputs: subscribes `relative_measurement` (with ~input relative_measurement;
@@ -83,6 +89,8 @@ class FollowerInputs {
   void start(ros::NodeHandle nh);
   /// The own odometry's topic ("" without a time headway), once started.
   std::string odometryTopic() const { return odometry_subscriber_.getTopic(); }
+  /// The neighbour arrays' topic ("" without formation.neighbours), once started.
+  std::string neighboursTopic() const { return neighbours_ ? neighbours_->topic() : std::string(); }
 
   /// Judges a relative measurement (from the subscription, or made by an input adapter such as
   /// OdometryInput) and, if accepted, writes it into the cycle (and, with ~trigger measurement,
@@ -142,7 +150,8 @@ class FollowerInputs {
   InlineCallbackQueue inline_queue_;
   ros::Subscriber measurement_subscriber_;
   ros::Subscriber leader_subscriber_;
-  ros::Subscriber odometry_subscriber_;  ///< only with a time headway (S1)
+  ros::Subscriber odometry_subscriber_;         ///< only with a time headway (S1)
+  std::unique_ptr<NeighbourInput> neighbours_;  ///< only with formation.neighbours
 };
 
 }  // namespace projection_collision_avoidance

@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <iomanip>
 #include <sstream>
 
@@ -9,6 +10,25 @@
 #include "follower/FollowerOutputs.hpp"
 
 namespace projection_collision_avoidance {
+namespace {
+
+/// A neighbour's perimeter by what its half-space did: blue sensed, yellow kept, orange binding
+/// (it acts on the command), magenta dropped (it could not be met).
+MarkerColor roleColor(NeighbourRole role) {
+  switch (role) {
+    case NeighbourRole::kSensed:
+      return {0.3F, 0.5F, 1.0F, 0.2F};
+    case NeighbourRole::kKept:
+      return {0.9F, 0.9F, 0.2F, 0.3F};
+    case NeighbourRole::kBinding:
+      return {1.0F, 0.45F, 0.0F, 0.55F};
+    case NeighbourRole::kDropped:
+      return {0.9F, 0.1F, 0.9F, 0.55F};
+  }
+  return {1.0F, 1.0F, 1.0F, 0.2F};
+}
+
+}  // namespace
 
 void FollowerOutputs::publishMarkers(const FollowerCycleOutput& out) {
   using visualization_msgs::Marker;
@@ -57,13 +77,34 @@ void FollowerOutputs::publishMarkers(const FollowerCycleOutput& out) {
   std::ostringstream label;
   label << std::fixed << std::setprecision(2) << "|xi| " << xi.norm() << " / xi_max " << out.xi_max
         << " m";
-  if (fallback) {
+  const NeighbourReport& neighbours = out.neighbours;
+  if (neighbours.configured && !neighbours.fresh) {
+    label << "\nNEIGHBOURS STALE: braking";
+  } else if (fallback) {
     label << "\nMEASUREMENT LOST: braking";
   } else if (out.mode == FollowerMode::kLeaderLost) {
     label << "\nleader broadcast lost";
   }
+  if (neighbours.binding >= 0) {
+    label << "\nkeeping out of " << neighbours.binding_id.data();
+  }
   text.text = label.str();
   markers.markers.push_back(text);
+  // Each sensed agent's perimeter, around it, coloured by what its half-space did (N3). They
+  // last two marker periods: an agent no longer sensed disappears.
+  const ros::Duration lifetime(2.0 / std::max(options_.marker_rate, 1e-3));
+  for (int j = 0; neighbours.configured && j < neighbours.count; ++j) {
+    const NeighbourMark& mark = neighbours.marks[static_cast<std::size_t>(j)];
+    visualization_msgs::Marker ring = toMarker(
+        frame, now, "neighbours", member_.index * NeighbourSample::kCapacity + j, Marker::SPHERE,
+        centre + mark.position, 2.0 * mark.perimeter, roleColor(mark.role));
+    if (axes < 3) {
+      ring.type = Marker::CYLINDER;
+      ring.scale.z = 0.01;
+    }
+    ring.lifetime = lifetime;
+    markers.markers.push_back(ring);
+  }
   marker_publisher_.publish(markers);
 }
 

@@ -1,5 +1,6 @@
 #include "projection_collision_avoidance/ros/FollowerNode.hpp"
 
+#include <cmath>
 #include <sstream>
 #include <system_error>
 
@@ -43,6 +44,16 @@ FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh,
     }
     options.path = configuration.formation.path;
   }
+  options.agent_name = member.name;
+  options.target_name = member.target_name;
+  if (configuration.formation.neighbours.enabled) {
+    // rho: formation.neighbours.perimeter, else alpha ||d|| of the scenario's d (as cf_sim).
+    const double perimeter = configuration.formation.neighbours.perimeter;
+    options.neighbours = NeighbourCycleSettings{
+        configuration.formation.neighbours,
+        std::isnan(perimeter) ? ControllerDesign::create(configuration.controller).perimeter
+                              : perimeter};
+  }
   if (options.lock_memory) {
     try {
       lockProcessMemory();
@@ -65,6 +76,7 @@ FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh,
   settings.measurement_trigger = options.trigger == ControlTrigger::kMeasurement;
   settings.turning = options.turning;
   settings.path = options.path;
+  settings.neighbours = options.neighbours;
   const ControllerDesign start = design;
   cycle_ = std::make_unique<FollowerCycle>(std::move(controller), parameters.separation, settings);
   try {
@@ -114,22 +126,26 @@ FollowerNode::FollowerNode(ros::NodeHandle nh, ros::NodeHandle private_nh,
   if (options.lock_memory) {
     loop << ", memory locked";
   }
-  ROS_INFO_STREAM(name << ": " << member.name << " looking at " << member.target_name << ", d = ["
-                       << parameters.separation.transpose() << "], running at "
-                       << parameters.control_rate << " Hz (input: " << toString(options.input)
-                       << ", trigger: " << toString(options.trigger) << loop.str() << "), "
-                       << parameters.model.double_integrator_axes << " axes, xi_max "
-                       << start.xi_max << " m"
-                       << (parameters.time_headway > 0.0
-                               ? ", time headway " + std::to_string(parameters.time_headway) +
-                                     " s from " + inputs_->odometryTopic()
+  ROS_INFO_STREAM(
+      name << ": " << member.name << " looking at " << member.target_name << ", d = ["
+           << parameters.separation.transpose() << "], running at " << parameters.control_rate
+           << " Hz (input: " << toString(options.input)
+           << ", trigger: " << toString(options.trigger) << loop.str() << "), "
+           << parameters.model.double_integrator_axes << " axes, xi_max " << start.xi_max << " m"
+           << (parameters.time_headway > 0.0
+                   ? ", time headway " + std::to_string(parameters.time_headway) + " s from " +
+                         inputs_->odometryTopic()
+                   : std::string())
+           << (options.turning ? ", turning slot (heading from " + inputs_->odometryTopic() +
+                                     " and the measurement)"
                                : std::string())
-                       << (options.turning ? ", turning slot (heading from " +
-                                                 inputs_->odometryTopic() + " and the measurement)"
-                                           : std::string())
-                       << (options.path ? ", path slot (the target's path from " +
-                                              inputs_->odometryTopic() + " and the measurement)"
-                                        : std::string()));
+           << (options.path ? ", path slot (the target's path from " + inputs_->odometryTopic() +
+                                  " and the measurement)"
+                            : std::string())
+           << (options.neighbours
+                   ? ", keeping out of every agent of " + inputs_->neighboursTopic() +
+                         " (perimeter " + std::to_string(options.neighbours->perimeter) + " m)"
+                   : std::string()));
 }
 
 FollowerNode::~FollowerNode() { stop(); }

@@ -7,6 +7,7 @@
 #include "projection_collision_avoidance/core/ControllerParameters.hpp"
 #include "projection_collision_avoidance/core/FollowerConfiguration.hpp"
 #include "projection_collision_avoidance/core/Formation.hpp"
+#include "projection_collision_avoidance/cycle/NeighbourSensing.hpp"
 #include "projection_collision_avoidance/cycle/StampCorrection.hpp"
 #include "projection_collision_avoidance/ros/RosParameters.hpp"
 #include "projection_collision_avoidance/vehicle/RelativeStateFromOdometry.hpp"
@@ -109,6 +110,11 @@ struct FollowerNodeOptions {
   /// The scenario's formation.path with formation.slots: path (a convoy on the target's path, its
   /// state from the own odometry `odom` and the measurement); empty: other slots.
   std::optional<ConvoyParameters> path;
+  /// The scenario's formation.neighbours: the follower keeps out of every agent of `neighbours`
+  /// (NeighbourArray, (N1)-(N3)); empty: the target alone.
+  std::optional<NeighbourCycleSettings> neighbours;
+  std::string agent_name;   ///< the follower's own id in those arrays (its formation name)
+  std::string target_name;  ///< its target's id there ("leader" or "follower_<j>")
   /// ~trigger: "timer" (default) or "measurement"; see FollowerNode.
   ControlTrigger trigger = ControlTrigger::kTimer;
   /// ~control_loop: "timer" (default) or "thread" (wall time only); see FollowerNode.

@@ -225,6 +225,18 @@ void FollowerOutputs::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat
                                                      std::to_string(inputs.foreign_messages) +
                                                      " messages refused)");
   }
+  const NeighbourReport& neighbours = s.neighbours;
+  if (neighbours.configured && s.mode != FollowerMode::kWaiting && !neighbours.fresh) {
+    status.mergeSummary(DiagnosticStatus::ERROR, "neighbour array stale: braking fallback");
+  }
+  if (neighbours.configured && std::isinf(neighbours.smallest_barrier) &&
+      neighbours.smallest_barrier < 0.0) {
+    status.mergeSummary(DiagnosticStatus::ERROR, "inside a neighbour's perimeter");
+  }
+  if (!inputs.neighbour_rejection.empty()) {
+    status.mergeSummary(DiagnosticStatus::WARN,
+                        "rejecting neighbour arrays: " + inputs.neighbour_rejection);
+  }
   status.add("mode", toString(s.mode));
   status.add("xi_norm (m)", xi_norm);
   status.add("xi_max (m)", s.xi_max);
@@ -270,6 +282,17 @@ void FollowerOutputs::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat
   status.add("late_periods", s.late_periods);
   status.add("held_measurements", s.held_measurements);
   status.add("tick_delay (s)", s.tick_delay);
+  if (neighbours.configured) {
+    status.add("neighbours_age (s)", inputs.neighbours_age);
+    status.add("rejected_neighbours", inputs.rejected_neighbours);
+    status.add("neighbours_sensed", neighbours.sensed);
+    status.add("neighbour_constraints", neighbours.kept);
+    status.add("neighbour_constraints_active", neighbours.active);
+    status.add("neighbour_constraints_dropped", neighbours.dropped);
+    status.add("nearest_neighbour (m)", neighbours.nearest);
+    status.add("neighbour_barrier (m/s)", neighbours.smallest_barrier);
+    status.add("binding_neighbour", std::string(neighbours.binding_id.data()));
+  }
 }
 
 }  // namespace projection_collision_avoidance

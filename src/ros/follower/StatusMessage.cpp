@@ -59,6 +59,22 @@ FollowerStatus toStatusMsg(const FollowerCycleOutput& out, const FollowerInputSt
   msg.held_measurements = out.held_measurements;
   msg.tick_delay = out.tick_delay;
   msg.time_jumps = out.time_jumps;
+  const NeighbourReport& n = out.neighbours;
+  msg.neighbours_configured = n.configured;
+  if (n.configured) {
+    msg.neighbours_fresh = n.fresh;
+    msg.neighbours_age = n.age;
+    msg.rejected_neighbours = static_cast<uint32_t>(inputs.rejected_neighbours);
+    msg.neighbours_sent = static_cast<uint32_t>(n.sent);
+    msg.neighbours_sensed = static_cast<uint32_t>(n.sensed);
+    msg.neighbour_constraints = static_cast<uint32_t>(n.kept);
+    msg.neighbour_constraints_active = static_cast<uint32_t>(n.active);
+    msg.neighbour_constraints_dropped = static_cast<uint32_t>(n.dropped);
+    msg.neighbour_projected = n.projected;
+    msg.nearest_neighbour = n.nearest;
+    msg.neighbour_barrier = n.smallest_barrier;
+    msg.binding_neighbour = n.binding_id.data();
+  }
   return msg;
 }
 
