@@ -76,9 +76,11 @@ PlantWorld::PlantWorld(ros::NodeHandle nh, ros::NodeHandle private_nh)
           "follower frame '" + frame + "' clashes with the world or leader frame");
     }
     // The world as cf_sim applies it (nothing without a world section), the true vehicle's lag
-    // sampled at the plant's step: the control period when ~rate is the control rate.
+    // sampled at the plant's step: the control period when ~rate is the control rate. The gusts
+    // are drawn up to the plant's own end when it runs longer than the scenario's duration (the
+    // same gusts as cf_sim's over that duration, and more after it).
     FollowerWorld world(scenario_.world, member.index, scenario_.controller.model,
-                        scenario_.duration, 1.0 / options_.rate);
+                        std::max(scenario_.duration, options_.duration), 1.0 / options_.rate);
     const SignalProfile disturbance = world.disturbance();
     followers_.push_back(Follower{
         Agent(member.name, frame, scenario_.controller.model, 1.0 / options_.rate,

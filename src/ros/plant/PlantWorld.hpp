@@ -53,12 +53,12 @@ namespace projection_collision_avoidance {
 /// that every agent integrates [t_k, t_k+1] with its answer to t_k, as cf_sim does.
 ///
 /// The scenario's `world` acts as in cf_sim (FollowerWorld): follower i integrates its
-/// disturbance w_i(t) (pulses, sinusoids, gusts drawn over the scenario's duration), each tick's
-/// held command goes through its true vehicle before it is integrated (and is published as
-/// applied_command so), and the world's noise of tick k is added to the relative state sampled
-/// at tick k. With formation.neighbours, each tick also publishes `<follower>/neighbours`
-/// (NeighbourArray: every other agent within formation.neighbours.radius, x_j - x_i exact,
-/// stamped and framed as that tick's relative_measurement).
+/// disturbance w_i(t) (pulses, sinusoids, gusts drawn up to the longer of the scenario's duration
+/// and ~duration), each tick's held command goes through its true vehicle before it is integrated
+/// (and is published as applied_command so), and the world's noise of tick k is added to the
+/// relative state sampled at tick k. With formation.neighbours, each tick first publishes
+/// `<follower>/neighbours` (NeighbourArray: every other agent within formation.neighbours.radius,
+/// x_j - x_i exact, stamped and framed as that tick's relative_measurement).
 ///
 /// An agent listed in ~vehicles with kind `velocity` or `unicycle` is a PlantVehicle instead: it
 /// takes Twists on `<agent>/cmd_vel` (and TwistStamped on `<agent>/cmd_vel_stamped`), publishes

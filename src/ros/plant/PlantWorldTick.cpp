@@ -26,15 +26,9 @@ bool PlantWorld::tick(long k) {
   }
   const ros::Time stamp = clock_->stampOf(k);
 
-  // Sample: odometry, tf, relative measurements.
-  std::vector<geometry_msgs::TransformStamped> transforms;
-  transforms.reserve(1 + followers_.size());
-  sampleAgent(&leader_, stamp, &transforms);
-  for (std::size_t i = 0; i < followers_.size(); ++i) {
-    sampleAgent(&followers_[i].agent, stamp, &transforms);
-    publishMeasurement(static_cast<int>(i), k);
-  }
-  if (!states_.empty()) {  // formation.neighbours: each follower's sensed agents
+  // formation.neighbours: each follower's sensed agents first, so that a follower that steps on
+  // its measurement finds the array of the same tick when the two reach it in the order sent.
+  if (!states_.empty()) {
     const auto store = [](const Agent& agent, Eigen::VectorXd* state) {
       if (agent.vehicle) {
         *state = agent.vehicle->state();
@@ -49,6 +43,14 @@ bool PlantWorld::tick(long k) {
     for (std::size_t i = 0; i < followers_.size(); ++i) {
       publishNeighbours(static_cast<int>(i), stamp);
     }
+  }
+  // Sample: odometry, tf, relative measurements.
+  std::vector<geometry_msgs::TransformStamped> transforms;
+  transforms.reserve(1 + followers_.size());
+  sampleAgent(&leader_, stamp, &transforms);
+  for (std::size_t i = 0; i < followers_.size(); ++i) {
+    sampleAgent(&followers_[i].agent, stamp, &transforms);
+    publishMeasurement(static_cast<int>(i), k);
   }
   tf_broadcaster_.sendTransform(transforms);
   if (k % ticks_per_marker_ == 0) {
