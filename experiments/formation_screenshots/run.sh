@@ -17,23 +17,28 @@
 #   doc/rviz_formation_path.png   figure_eight_2d, 4 followers, chain, line, slots:=path,
 #                                 t = 13 s (the convoy on the leader's loop), seen from above
 #                                 (rviz/formation_path.rviz)
+#   doc/rviz_neighbours.png       crowd_v4_gust, 4 followers, star, V, formation.neighbours,
+#                                 t = 21.5 s (follower 2 pushed toward follower 1), each sensed
+#                                 agent's perimeter coloured by what its constraint does
+#                                 (formation.rviz)
 # Usage: experiments/formation_screenshots/run.sh [2d] [3d] [chain] [vehicles] [turning] [path]
-#   (default: all six; ~1 min each)
+#   [neighbours] (default: all seven; ~1 min each)
 #   OUT_DIR (default doc/), REAL_TIME_FACTOR (default 0.5), ROS_PORT (default 11412: its own
-#   master, apart from other tests), SCREEN_DISPLAY (default :98). Needs a built workspace
-#   (scripts/build.sh). The PNGs are reduced to 256 colours (ImageMagick `convert`).
+#   master, apart from other tests), SCREEN_DISPLAY (default :98), BUILD_DIR (default build/,
+#   built by scripts/build.sh when missing). The PNGs are reduced to 256 colours (ImageMagick `convert`).
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
 out=${OUT_DIR:-$root/doc}
 rtf=${REAL_TIME_FACTOR:-0.5}
 port=${ROS_PORT:-11412}
 shots=("$@")
-(( ${#shots[@]} )) || shots=(2d 3d chain vehicles turning path)
+(( ${#shots[@]} )) || shots=(2d 3d chain vehicles turning path neighbours)
 launch=formation.launch  # the launch file of the current shot
-test -f "$root/build/devel/setup.bash" || "$root/scripts/build.sh" >/dev/null
+build=${BUILD_DIR:-$root/build}
+test -f "$build/devel/setup.bash" || BUILD_DIR=$build "$root/scripts/build.sh" >/dev/null
 set +u  # the workspace's setup scripts read unset variables
 # shellcheck disable=SC1091
-source "$root/build/devel/setup.bash"
+source "$build/devel/setup.bash"
 set -u
 export LIBGL_ALWAYS_SOFTWARE=1 DISPLAY=${SCREEN_DISPLAY:-:98}
 export ROS_MASTER_URI=http://localhost:$port
@@ -118,9 +123,12 @@ for shot in "${shots[@]}"; do
     path) shoot 13 "$out/rviz_formation_path.png" "$root/rviz/formation_path.rviz" \
           scenario:="$root/config/scenarios/figure_eight_2d.yaml" followers:=4 topology:=chain \
           shape:=line slots:=path ;;
+    neighbours) shoot 21.5 "$out/rviz_neighbours.png" "$root/rviz/formation.rviz" \
+          scenario:="$root/config/scenarios/crowd_v4_gust.yaml" followers:=4 topology:=star \
+          shape:=v neighbours:="{braking_acceleration: 1, neighbour_acceleration: 2, rate: 1}" ;;
     vehicles) launch=vehicles.launch
           shoot 21.5 "$out/rviz_vehicles.png" "$root/rviz/formation.rviz" followers:=3 kind:=unicycle
           launch=formation.launch ;;
-    *) echo "formation_screenshots: unknown shot '$shot' (2d, 3d, chain, vehicles, turning, path)"; exit 1 ;;
+    *) echo "formation_screenshots: unknown shot '$shot' (2d, 3d, chain, vehicles, turning, path, neighbours)"; exit 1 ;;
   esac
 done

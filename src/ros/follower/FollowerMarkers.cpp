@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <cmath>
 #include <iomanip>
 #include <sstream>
 
@@ -12,8 +13,8 @@
 namespace projection_collision_avoidance {
 namespace {
 
-/// A neighbour's perimeter by what its half-space did: blue sensed, yellow kept, orange binding
-/// (it acts on the command), magenta dropped (it could not be met).
+/// A neighbour's perimeter by what its half-space did: yellow kept, orange binding (it acts on the
+/// command), magenta dropped (it could not be met); blue sensed (not drawn).
 MarkerColor roleColor(NeighbourRole role) {
   switch (role) {
     case NeighbourRole::kSensed:
@@ -90,20 +91,54 @@ void FollowerOutputs::publishMarkers(const FollowerCycleOutput& out) {
   }
   text.text = label.str();
   markers.markers.push_back(text);
-  // Each sensed agent's perimeter, around it, coloured by what its half-space did (N3). They
-  // last two marker periods: an agent no longer sensed disappears.
+  // The perimeter of each agent whose half-space is given to the command, as a ring around it
+  // coloured by what the half-space does (N3), and a line to the one that acts. Sensed agents
+  // that constrain nothing are not drawn. Each lasts two marker periods: an agent that no longer
+  // constrains disappears.
   const ros::Duration lifetime(2.0 / std::max(options_.marker_rate, 1e-3));
   for (int j = 0; neighbours.configured && j < neighbours.count; ++j) {
     const NeighbourMark& mark = neighbours.marks[static_cast<std::size_t>(j)];
+    if (mark.role == NeighbourRole::kSensed) {
+      continue;
+    }
+    const bool binding = mark.role == NeighbourRole::kBinding;
     visualization_msgs::Marker ring = toMarker(
         frame, now, "neighbours", member_.index * NeighbourSample::kCapacity + j, Marker::SPHERE,
         centre + mark.position, 2.0 * mark.perimeter, roleColor(mark.role));
-    if (axes < 3) {
-      ring.type = Marker::CYLINDER;
-      ring.scale.z = 0.01;
+    if (axes < 3) {  // a ring on the ground plane
+      ring.type = Marker::LINE_STRIP;
+      ring.scale.x = binding ? 0.12 : 0.05;
+      ring.scale.y = ring.scale.z = 0.0;
+      ring.color.a = 0.9F;
+      constexpr int kSegments = 48;
+      for (int k = 0; k <= kSegments; ++k) {
+        const double angle = 2.0 * M_PI * k / kSegments;
+        geometry_msgs::Point point;
+        point.x = mark.perimeter * std::cos(angle);
+        point.y = mark.perimeter * std::sin(angle);
+        ring.points.push_back(point);
+      }
     }
     ring.lifetime = lifetime;
     markers.markers.push_back(ring);
+    if (binding) {
+      visualization_msgs::Marker line =
+          toMarker(frame, now, "neighbour_binding", member_.index * NeighbourSample::kCapacity + j,
+                   Marker::LINE_LIST, Eigen::Vector3d::Zero(), 0.06, roleColor(mark.role));
+      line.scale.y = line.scale.z = 0.0;
+      line.color.a = 0.9F;
+      geometry_msgs::Point from;
+      from.x = centre.x();
+      from.y = centre.y();
+      from.z = centre.z();
+      geometry_msgs::Point to;
+      to.x = from.x + mark.position.x();
+      to.y = from.y + mark.position.y();
+      to.z = from.z + mark.position.z();
+      line.points = {from, to};
+      line.lifetime = lifetime;
+      markers.markers.push_back(line);
+    }
   }
   marker_publisher_.publish(markers);
 }
