@@ -47,6 +47,7 @@ FollowerCycle::FollowerCycle(std::unique_ptr<DynamicFollowerController> controll
     slot_heading_.emplace(*settings_.turning, period_);
   }
   if (settings_.path) {
+    own_position_.setZero(handover_.current().inputDimension());
     path_slot_.emplace(
         *settings_.path, period_, separation_,
         static_cast<int>(handover_.current().design().parameters.model.position_dimension));
@@ -247,8 +248,15 @@ bool FollowerCycle::pathSlot(std::int64_t stamp_ns, const GenericDimensions::Sta
     mode_ = FollowerMode::kMeasurementLost;  // no target state: brake
     out->mode = mode_;
   }
+  // The own controlled point at the measurement's stamp, at its own velocity: the two inputs of
+  // the target's position (own + measured) may come from different samples (an odometry slower
+  // than the measurement, or one delayed behind it).
   const OwnStateSample& own = inputs_.ownState();
-  path_slot_->step(known, own.controlled_position, own.controlled_velocity, state, &out->slot,
+  const double lag =
+      std::clamp(kNanosecond * static_cast<double>(inputs_.measurement().stamp_ns - own.stamp_ns),
+                 -settings_.measurement_timeout, settings_.measurement_timeout);
+  own_position_.noalias() = own.controlled_position + lag * own.controlled_velocity;
+  path_slot_->step(known, own_position_, own.controlled_velocity, state, &out->slot,
                    &slot_acceleration_);
   out->heading_known = known;
   return true;

@@ -1,7 +1,8 @@
 /// The follower's control cycle with path slots (doc/math.md, "Convoys on the target's path"),
 /// without ROS: the target's state is the own odometry's plus the measured relative state; the
 /// first step waits for the own state; the slot is x_target − [r; r'] with r on the target's path
-/// whatever the own state is; a stale own state brakes; a path step allocates nothing.
+/// whatever the own state is; an odometry slower than the measurement is moved to its stamp; a
+/// stale own state brakes; a path step allocates nothing.
 
 #include <cstdint>
 #include <memory>
@@ -117,6 +118,36 @@ TEST(FollowerCyclePath, TheSlotFollowsTheTargetsPathWhateverTheOwnStateIs) {
   GenericDimensions::StateVector own(4);
   own << -3.0 + 0.4 * 19.99, 2.0, 0.4, 0.0;
   EXPECT_LT((b.xi - ((targetAt(19.99, 0.5) - own) - b.slot)).norm(), 1e-9);
+}
+
+TEST(FollowerCyclePath, AnOdometrySlowerThanTheMeasurementIsMovedToItsStamp) {
+  // The same follower driving at a constant velocity behind a target along +x: its odometry at
+  // every step, or at every third one only (the steps between use the one before, moved to the
+  // measurement's stamp at its velocity): the same path, the same slot.
+  const auto own = [](double t) {
+    GenericDimensions::StateVector x(4);
+    x << -7.5 + 1.2 * t, 0.3, 1.2, 0.0;
+    return x;
+  };
+  std::unique_ptr<FollowerCycle> every = makePathCycle();
+  std::unique_ptr<FollowerCycle> third = makePathCycle();
+  FollowerCycleOutput a;
+  FollowerCycleOutput b;
+  std::int64_t t = kStart;
+  for (int k = 0; k < 500; ++k, t += 10 * kMs) {
+    const double seconds = 0.01 * k;
+    const GenericDimensions::StateVector relative = targetAt(seconds, 1.0) - own(seconds);
+    every->ownState().write(ownStateOf(t, k + 1, own(seconds)));
+    if (k % 3 == 0) {
+      third->ownState().write(ownStateOf(t, k / 3 + 1, own(seconds)));
+    }
+    every->measurement().write(measurementOf(t, k + 1, relative));
+    third->measurement().write(measurementOf(t, k + 1, relative));
+    ASSERT_TRUE(every->tick(t, 0.0, 0, &a));
+    ASSERT_TRUE(third->tick(t, 0.0, 0, &b));
+    ASSERT_LT((a.slot - b.slot).norm(), 1e-9) << k;
+  }
+  EXPECT_EQ(b.mode, FollowerMode::kTracking);
 }
 
 TEST(FollowerCyclePath, AStaleOwnStateBrakesUntilItIsBack) {

@@ -237,7 +237,8 @@ class FollowerCycle {
   bool turnSlot(std::int64_t stamp_ns, const GenericDimensions::StateVector& state,
                 FollowerCycleOutput* out);
   /// D and u_r of a path slot (PathSlot); false when the first step must wait for the own state.
-  /// A step without a fresh own state is one of mode measurement_lost.
+  /// A step without a fresh own state is one of mode measurement_lost. The own controlled point
+  /// is moved to the measurement's stamp at its velocity (by at most measurement_timeout).
   bool pathSlot(std::int64_t stamp_ns, const GenericDimensions::StateVector& state,
                 FollowerCycleOutput* out);
   /// formation.neighbours: the half-spaces of the step stamped @p stamp_ns from the latest
@@ -258,6 +259,7 @@ class FollowerCycle {
   std::optional<PathSlot> path_slot_;                 ///< r (C1)-(C5) of a path slot
   std::optional<NeighbourSensing> neighbours_;        ///< (N1)-(N3) with formation.neighbours
   GenericDimensions::InputVector slot_acceleration_;  ///< u_r (T3) of the step
+  GenericDimensions::InputVector own_position_;       ///< path slots: own point at the stamp
   double period_ = 0.0;
   std::mutex trigger_mutex_;  ///< measurement trigger only: callback steps vs braking ticks
   LatchedInputs inputs_;
