@@ -1,12 +1,14 @@
 #!/usr/bin/python3
 """rostest: the `neighbours` input of a follower with formation.neighbours (doc/boundary.md), fed
 by the test as a third-party sender would: the first step waits for an array; each malformed
-array is refused whole and counted; a stale one brakes the follower until a fresh one comes; an
-agent closing in binds the command; a flood of the largest arrays and one far too large leave
+array, a repeated stamp (a duplicating sender) and a second publisher's array are refused whole
+and counted; a stale one brakes the follower until a fresh one comes; an agent closing in binds
+the command; a flood of the largest arrays and one far too large leave
 the node running. Parameters: ~wall_deadline (s) per condition, ~measurement_timeout (s, the
 follower's), ~flood_messages and ~flood_entries (the flood), ~oversized_entries."""
 
 import math
+import subprocess
 import sys
 import threading
 import unittest
@@ -117,12 +119,21 @@ class BadNeighbours(unittest.TestCase):
             ("zero stamp", dict(stamp=rospy.Time(0))),
             ("future stamp", dict(stamp_offset=10.0)),
             ("older than the last", dict(stamp=accepted - rospy.Duration(0.001))),
+            ("repeated stamp (a duplicating sender)", dict(stamp=accepted)),
         ]
         for count, (name, fields) in enumerate(header_cases, start=len(cases) + 1):
             self.send(calm_crowd(), **fields)
             self.wait(lambda s, c=count: s.rejected_neighbours == c,
                       f"{name}: rejected {self.rejected()}, expected {count}")
         self.assertTrue(all(math.isfinite(u) for u in self.latest().command))
+        # A second publisher (another node) while this one holds the input: refused and counted.
+        count = len(cases) + len(header_cases) + 1
+        subprocess.run(["rostopic", "pub", "-1", "/follower_1/neighbours",
+                        "projection_collision_avoidance/NeighbourArray",
+                        "{header: {stamp: now, frame_id: world}, neighbours: []}"],
+                       check=True, timeout=self.deadline, stdout=subprocess.DEVNULL)
+        self.wait(lambda s: s.rejected_neighbours == count,
+                  f"second publisher: rejected {self.rejected()}, expected {count}")
 
         # Refused arrays leave the last accepted one, which goes stale: the follower brakes.
         self.wait(lambda s: s.mode == FollowerStatus.MODE_MEASUREMENT_LOST
