@@ -111,26 +111,29 @@ TEST(FollowerCycle, TheControlThreadAllocatesAndFreesNothing) {
       std::this_thread::yield();
     }
   });
-  // The publisher's side: takes every output (and would build messages from it).
+  // The publisher's side: takes every output (and would build messages from it). A publisher
+  // held off the processor lets the handoff drop outputs (counted), so the steps are counted on
+  // the control thread, where they are made.
   long published = 0;
-  long steps_seen = 0;
-  long headway_steps = 0;
   std::thread publisher([&] {
     FollowerCycleOutput out;
     std::uint32_t seen = outputs.count();
-    while (!done || outputs.pop(&out)) {
+    for (bool last_round = false; !last_round;) {
+      last_round = done.load();  // after done, one more round takes what is left
       while (outputs.pop(&out)) {
         ++published;
-        steps_seen += out.stepped ? 1 : 0;
-        headway_steps += out.stepped && out.own_state_fresh ? 1 : 0;
       }
-      seen = outputs.wait(seen, 10 * kMs);
+      if (!last_round) {
+        seen = outputs.wait(seen, 10 * kMs);
+      }
     }
   });
 
   // The control thread: ticks, a reconfiguration adopted half way, every output handed off.
   long allocations = -1;
   long frees = -1;
+  long steps_seen = 0;
+  long headway_steps = 0;
   std::unique_ptr<DynamicFollowerController> offered =
       std::make_unique<DynamicFollowerController>(run2Design(0.5));
   std::thread control([&] {
@@ -152,6 +155,8 @@ TEST(FollowerCycle, TheControlThreadAllocatesAndFreesNothing) {
       tick.period = kMs;
       cycle->tickOn(
           tick, [now] { return now; }, &out);
+      steps_seen += out.stepped ? 1 : 0;
+      headway_steps += out.stepped && out.own_state_fresh ? 1 : 0;
       outputs.post(out);
       std::this_thread::sleep_for(std::chrono::microseconds(50));
     }
