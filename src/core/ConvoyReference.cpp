@@ -71,6 +71,7 @@ void ConvoyReference::reset(const Eigen::Vector3d& target_position,
   velocity_ = target_velocity.allFinite() ? Eigen::Vector3d(along * along.dot(target_velocity))
                                           : Eigen::Vector3d::Zero();
   have_goal_ = false;
+  have_sample_ = false;
 }
 
 Eigen::Vector3d ConvoyReference::acceleration(const Eigen::Vector3d& goal,
@@ -131,6 +132,19 @@ Eigen::Vector3d ConvoyReference::acceleration(const Eigen::Vector3d& goal,
 
 ConvoySample ConvoyReference::tick(const Eigen::Vector3d& target_position,
                                    const Eigen::Vector3d& target_velocity) {
+  return tick(target_position, target_velocity, period_);
+}
+
+ConvoySample ConvoyReference::tick(const Eigen::Vector3d& target_position,
+                                   const Eigen::Vector3d& target_velocity, double interval) {
+  if (have_sample_) {
+    if (!(interval > 0.0)) {
+      return last_sample_;  // no time passed since the tick before: nothing new
+    }
+    // r'' held over the interval since the tick before, r and r' integrated exactly with it.
+    position_ += interval * velocity_ + 0.5 * interval * interval * last_sample_.acceleration;
+    velocity_ += interval * last_sample_.acceleration;
+  }
   // A target position not known this tick (not finite) records nothing and the goal keeps its
   // arc and point (q' = 0): the reference comes to rest at the last goal. Without a finite
   // velocity too, the target is unknown to (C3)'s speed bound and to (C5).
@@ -143,11 +157,11 @@ ConvoySample ConvoyReference::tick(const Eigen::Vector3d& target_position,
     if (have_goal_) {
       upper = std::min(upper, previous_goal_arc_ +
                                   std::max(0.0, path_.progress() - previous_progress_) +
-                                  parameters_.catch_up_speed * period_);
+                                  parameters_.catch_up_speed * interval);
     }
     const double arc = path_.walkBack(upper, target_position, goal_chord_);
     const Eigen::Vector3d goal = path_.at(arc);
-    goal_velocity = have_goal_ ? Eigen::Vector3d((goal - previous_goal_) / period_)
+    goal_velocity = have_goal_ ? Eigen::Vector3d((goal - previous_goal_) / interval)
                                : Eigen::Vector3d(velocity_);
     previous_progress_ = path_.progress();
     previous_goal_arc_ = arc;
@@ -162,8 +176,8 @@ ConvoySample ConvoyReference::tick(const Eigen::Vector3d& target_position,
   sample.acceleration = acceleration(sample.goal, goal_velocity, target_position, target_velocity,
                                      known, &sample.braking);
   sample.chord = known ? (target_position - position_).norm() : 0.0;
-  position_ += period_ * velocity_ + 0.5 * period_ * period_ * sample.acceleration;
-  velocity_ += period_ * sample.acceleration;
+  last_sample_ = sample;
+  have_sample_ = true;
   return sample;
 }
 

@@ -256,7 +256,11 @@ bool FollowerCycle::pathSlot(std::int64_t stamp_ns, const GenericDimensions::Sta
       std::clamp(kNanosecond * static_cast<double>(inputs_.measurement().stamp_ns - own.stamp_ns),
                  -settings_.measurement_timeout, settings_.measurement_timeout);
   own_position_.noalias() = own.controlled_position + lag * own.controlled_velocity;
-  path_slot_->step(known, own_position_, own.controlled_velocity, state, &out->slot,
+  // The reference keeps the measurement's time (the step's without one): a step that reads the
+  // measurement of the step before, as a timer tick ahead of the sample it waits for does, finds
+  // r where that step left it.
+  const std::int64_t time = known ? inputs_.measurement().stamp_ns : stamp_ns;
+  path_slot_->step(time, known, own_position_, own.controlled_velocity, state, &out->slot,
                    &slot_acceleration_);
   out->heading_known = known;
   return true;
@@ -267,6 +271,9 @@ void FollowerCycle::noteTime(std::int64_t now_ns) {
   if (time_.wentBack(now_ns)) {
     have_stamp_ = false;
     pacer_.reset();
+    if (path_slot_) {
+      path_slot_->restartClock();
+    }
   }
 }
 

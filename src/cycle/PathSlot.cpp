@@ -1,5 +1,6 @@
 #include "projection_collision_avoidance/cycle/PathSlot.hpp"
 
+#include <cmath>
 #include <limits>
 #include <stdexcept>
 
@@ -9,7 +10,9 @@ PathSlot::PathSlot(const ConvoyParameters& parameters, double period,
                    const GenericDimensions::StateVector& separation, int axes)
     : reference_(parameters, period, separation.head(axes).norm()),
       axes_(axes),
-      target_(GenericDimensions::StateVector::Zero(separation.size())) {
+      target_(GenericDimensions::StateVector::Zero(separation.size())),
+      period_(period),
+      period_ns_(std::llround(1e9 * period)) {
   if (axes < 1 || axes > 3 || separation.size() != 2 * axes) {
     throw std::invalid_argument("PathSlot: 1 to 3 position axes and d of 2 axes entries");
   }
@@ -17,7 +20,8 @@ PathSlot::PathSlot(const ConvoyParameters& parameters, double period,
   direction_.head(axes) = separation.head(axes).normalized();
 }
 
-void PathSlot::step(bool known, const GenericDimensions::InputVector& own_position,
+void PathSlot::step(std::int64_t time_ns, bool known,
+                    const GenericDimensions::InputVector& own_position,
                     const GenericDimensions::InputVector& own_velocity,
                     const GenericDimensions::StateVector& relative,
                     GenericDimensions::StateVector* slot,
@@ -36,7 +40,18 @@ void PathSlot::step(bool known, const GenericDimensions::InputVector& own_positi
       started_ = true;
     }
   }
-  sample_ = reference_.tick(position, velocity);
+  // The time since the sample before: T exactly when it is one period (ns rounded), nothing for
+  // the same time or an earlier one (a stale input, a new timeline's first step).
+  double interval = 0.0;
+  if (have_time_ && time_ns > time_ns_) {
+    const std::int64_t elapsed = time_ns - time_ns_;
+    interval = elapsed == period_ns_ ? period_ : 1e-9 * static_cast<double>(elapsed);
+  }
+  if (!have_time_ || time_ns > time_ns_) {
+    time_ns_ = time_ns;
+    have_time_ = true;
+  }
+  sample_ = reference_.tick(position, velocity, interval);
   convoySlotOffset(target_, axes_, sample_, slot);       // D (C4)
   convoySlotAcceleration(sample_, axes_, acceleration);  // u_r (C4)
 }

@@ -310,5 +310,41 @@ TEST(ConvoyReference, LostTargetPositionDoesNotThrowTheGoalBack) {
             1e-3);
 }
 
+TEST(ConvoyReference, AnIntervalAdvancesByItsTimeAndNoTimeRepeatsTheSample) {
+  ConvoyParameters p;
+  const auto target = [](int k) {
+    return TargetState{Vector3(10.0 + 1.5 * kPeriod * k, 0.5, 0.0), Vector3(1.5, 0.0, 0.0)};
+  };
+  ConvoyReference by_period(p, kPeriod, 5.0);
+  ConvoyReference by_interval(p, kPeriod, 5.0);
+  by_period.reset(target(0).position, target(0).velocity, Vector3::UnitX());
+  by_interval.reset(target(0).position, target(0).velocity, Vector3::UnitX());
+  ConvoySample before = by_interval.tick(target(0).position, target(0).velocity, 0.03);
+  EXPECT_EQ(before.position, by_period.tick(target(0).position, target(0).velocity).position)
+      << "the first tick after reset samples r(0) whatever the interval";
+  for (int k = 1; k < 300; ++k) {  // tick() is tick(.., T), bit for bit
+    const ConvoySample a = by_period.tick(target(k).position, target(k).velocity);
+    const ConvoySample b = by_interval.tick(target(k).position, target(k).velocity, kPeriod);
+    ASSERT_EQ(a.position, b.position) << k;
+    ASSERT_EQ(a.velocity, b.velocity) << k;
+    ASSERT_EQ(a.acceleration, b.acceleration) << k;
+    before = b;
+  }
+  // No time (0, less, NaN): the sample before, whatever the target now is.
+  for (const double none : {0.0, -kPeriod, kNan}) {
+    const ConvoySample same = by_interval.tick(Vector3(50.0, 3.0, 0.0), Vector3::Zero(), none);
+    EXPECT_EQ(same.position, before.position);
+    EXPECT_EQ(same.goal, before.goal);
+    EXPECT_EQ(same.acceleration, before.acceleration);
+  }
+  // An interval of 3 T: r and r' advance over it with the r'' before held.
+  const double dt = 3.0 * kPeriod;
+  const ConvoySample after = by_interval.tick(target(302).position, target(302).velocity, dt);
+  const Vector3 position =
+      before.position + dt * before.velocity + 0.5 * dt * dt * before.acceleration;
+  EXPECT_LT((after.position - position).norm(), 1e-12);
+  EXPECT_LT((after.velocity - (before.velocity + dt * before.acceleration)).norm(), 1e-12);
+}
+
 }  // namespace
 }  // namespace projection_collision_avoidance

@@ -72,7 +72,8 @@ struct ConvoySample {
 ///        v_t = n . v_t, h = c − c_min − max(v_r, 0)^2 / (2 a_b) + max(v_t, 0)^2 / (2 A); n . r''
 ///        is bounded by max(−a_max, a_b (omega h + min(0, v_t) − v_r) / max(v_r, a_b T)), the
 ///        rest of r''_0 kept within a_max.
-///        r'' is held over T and r, r' integrated exactly with it: r is C^1, xi never jumps.
+///        r'' is held over T (or the interval to the next tick) and r, r' integrated exactly
+///        with it: r is C^1, xi never jumps.
 /// Allocates no memory after construction.
 class ConvoyReference {
  public:
@@ -86,9 +87,15 @@ class ConvoyReference {
   void reset(const Eigen::Vector3d& target_position, const Eigen::Vector3d& target_velocity,
              const Eigen::Vector3d& direction);
 
-  /// The sample at this tick, the target at @p target_position (m) moving at
-  /// @p target_velocity (m/s); then r and r' advance to the next tick.
+  /// The sample one period T after the tick before (the first after reset(): at r(0)), the
+  /// target at @p target_position (m) moving at @p target_velocity (m/s): tick(.., .., T).
   ConvoySample tick(const Eigen::Vector3d& target_position, const Eigen::Vector3d& target_velocity);
+  /// The sample @p interval (s) after the tick before: r and r' first advance over it with the
+  /// r'' of that tick held (C3); the goal's speed bound c and q' (C2), (C3) take the interval.
+  /// An interval of 0 or less (or NaN) passes no time: the tick before's sample, unchanged.
+  /// The barrier (C5) plans with T, so its guarantee holds for intervals up to T.
+  ConvoySample tick(const Eigen::Vector3d& target_position, const Eigen::Vector3d& target_velocity,
+                    double interval);
 
   const TargetPath& path() const { return path_; }
   double gap() const { return gap_; }
@@ -113,6 +120,8 @@ class ConvoyReference {
   double previous_progress_ = 0.0;
   double previous_goal_arc_ = 0.0;
   bool have_goal_ = false;
+  ConvoySample last_sample_;  ///< the tick before's; its r'' is held until this tick
+  bool have_sample_ = false;
 };
 
 /// The convoy's slot D = x_target − [r; r'] (m, m/s) of a k-axis double integrator (k = 2 or 3),

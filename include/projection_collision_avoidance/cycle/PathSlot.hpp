@@ -1,5 +1,7 @@
 #pragma once
 
+#include <cstdint>
+
 #include <Eigen/Core>
 
 #include "projection_collision_avoidance/core/ConvoyReference.hpp"
@@ -24,18 +26,26 @@ class PathSlot {
   /// Whether the first known target has started the path.
   bool started() const { return started_; }
 
-  /// One control period. With @p known the target is @p own_position + relative position and
-  /// @p own_velocity + relative velocity (@p relative = x_target − x_i, m and m/s); without it the
-  /// target is unknown to the reference (its goal holds, r comes to rest) and D keeps the last
-  /// target. The first call must be known (it resets the path at the target). Writes D into
-  /// @p slot (n entries) and u_r into @p acceleration (axes entries).
-  void step(bool known, const GenericDimensions::InputVector& own_position,
+  /// One step at the time @p time_ns (ns) its inputs describe: the measurement's stamp when
+  /// @p known, else the step's. The reference advances by the time since the step before (T when
+  /// it is one period), not by a period per call, so that it keeps to the measured own state
+  /// whichever step reads which measurement: a step on the same measurement as the one before
+  /// gives the same sample, one after a skipped measurement advances two periods.
+  /// With @p known the target is @p own_position + relative position and
+  /// @p own_velocity + relative velocity (@p relative = x_target − x_i, m and m/s; @p own_position
+  /// at @p time_ns); without it the target is unknown to the reference (its goal holds, r comes
+  /// to rest) and D keeps the last target. The first call must be known (it resets the path at
+  /// the target). Writes D into @p slot (n entries) and u_r into @p acceleration (axes entries).
+  void step(std::int64_t time_ns, bool known, const GenericDimensions::InputVector& own_position,
             const GenericDimensions::InputVector& own_velocity,
             const GenericDimensions::StateVector& relative, GenericDimensions::StateVector* slot,
             GenericDimensions::InputVector* acceleration);
 
   /// The latest sample of the reference (r, r', r'', the goal, the path's progress).
   const ConvoySample& sample() const { return sample_; }
+
+  /// Time went back (a new timeline): the next step's time starts the reference's clock afresh.
+  void restartClock() { have_time_ = false; }
 
  private:
   ConvoyReference reference_;
@@ -44,6 +54,10 @@ class PathSlot {
   bool started_ = false;
   GenericDimensions::StateVector target_;  ///< x_target of the latest known step
   ConvoySample sample_;
+  double period_;             ///< T (s)
+  std::int64_t period_ns_;    ///< T (ns), rounded
+  std::int64_t time_ns_ = 0;  ///< the time of the latest sample
+  bool have_time_ = false;
 };
 
 }  // namespace projection_collision_avoidance
