@@ -16,6 +16,7 @@ set(PCA_CORE_SOURCES
   src/core/LinearAlgebra.cpp
   src/core/NeighbourBarrier.cpp
   src/core/PlatoonLaws.cpp
+  src/core/SafetyFilter.cpp
   src/core/TargetPath.cpp
   src/core/TurningSlot.cpp
 )

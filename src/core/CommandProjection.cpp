@@ -292,6 +292,7 @@ CommandProjectionResult CommandProjection::project(const Eigen::Vector3d& nomina
     const double slack = std::max(tol, kFeasibilityTolerance * std::abs(offsets_[j]));
     if ((kept & bit(j)) != 0U && std::abs(normals_[j].dot(x) - offsets_[j]) <= slack) {
       ++result.active;
+      result.active_mask |= bit(j);
     }
   }
   result.ball_active = std::isfinite(max_norm) && euclideanNorm(x) >= max_norm - tol;

@@ -20,6 +20,8 @@ struct CommandProjectionResult {
   bool changed = false;
   /// Kept half-spaces that hold with equality at u* (within the feasibility tolerance).
   int active = 0;
+  /// Bit j set: half-space j is one of the active ones.
+  std::uint32_t active_mask = 0;
   /// true when ||u*|| = a_max (within the feasibility tolerance); never for a_max = infinity.
   bool ball_active = false;
   /// Half-spaces dropped by the fallback (0 when the whole set is non-empty).
