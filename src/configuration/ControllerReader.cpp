@@ -148,6 +148,25 @@ ControllerParameters readController(YamlReader& reader, const AgentModel& model,
     }
     spacing.finish();
   }
+  if (controller.has("safety_filter")) {
+    YamlReader filter = controller.map("safety_filter");
+    SafetyFilterParameters parameters;
+    if (filter.has("rate")) {
+      parameters.rate = filter.number("rate");
+    }
+    filter.finish();
+    parameters.validate(controller.key("safety_filter"));
+    if (result.tracker_enabled) {
+      throw ParameterError(tracker.key("enabled"),
+                           "must be false with controller.safety_filter: the barrier filter's "
+                           "nominal command is the baseline law");
+    }
+    if (!model.isDoubleIntegrator()) {
+      throw ParameterError(controller.key("safety_filter"),
+                           "needs a double_integrator model (the barrier (B1) is on positions)");
+    }
+    result.safety_filter = parameters;
+  }
   controller.finish();
   validatePlatoonParameters(result);  // the new keys' own checks, before any derived one
   return result;

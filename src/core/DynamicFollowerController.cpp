@@ -68,6 +68,7 @@ const DynamicFollowerStatus& DynamicFollowerController::step(const DynamicStepIn
     StepInputs<typename C::Dimensions> converted;
     converted.period_fraction = inputs.period_fraction;
     converted.command_constraints = inputs.command_constraints;
+    converted.safety_filter = inputs.safety_filter;
     if (inputs.measurement) {
       converted.measurement = as<typename C::OutputVector>(*inputs.measurement);
     }

@@ -57,6 +57,8 @@ FollowerCycle::FollowerCycle(std::unique_ptr<DynamicFollowerController> controll
     neighbours_.emplace(*settings_.neighbours, static_cast<int>(p.model.position_dimension),
                         p.acceleration_limit);
   }
+  barriers_.emplace(
+      static_cast<int>(handover_.current().design().parameters.model.position_dimension));
 }
 
 FollowerCycle::~FollowerCycle() = default;
@@ -146,6 +148,8 @@ bool FollowerCycle::step(std::int64_t now_ns, std::int64_t stamp_ns, double dela
   const std::int64_t stamp =
       have_stamp_ && stamp_ns <= last_stamp_ns_ ? last_stamp_ns_ + 1 : stamp_ns;
   DynamicStepInputs inputs;  // without a measurement the step runs the fallback
+  out->barriers = BarrierReport{};
+  out->barriers.configured = design.parameters.safety_filter.has_value();
   inputs.command_constraints = constrainByNeighbours(stamp_ns, design.perimeter, out);
   if (settings_.measurement_trigger && have_stamp_) {
     inputs.period_fraction =
@@ -161,6 +165,11 @@ bool FollowerCycle::step(std::int64_t now_ns, std::int64_t stamp_ns, double dela
   if (use_leader) {
     inputs.leader_input.emplace(inputs_.leader().acceleration);
   }
+  if (inputs.measurement) {
+    inputs.safety_filter =
+        senseBarriers(state, inputs.leader_input ? &*inputs.leader_input : nullptr,
+                      inputs.command_constraints != nullptr);
+  }
   if (slot_heading_ || path_slot_) {
     inputs.slot_acceleration.emplace(slot_acceleration_);
   }
@@ -173,7 +182,9 @@ bool FollowerCycle::step(std::int64_t now_ns, std::int64_t stamp_ns, double dela
   out->measurement_age = ages.measurement_age;
   out->leader_age = ages.leader_age;
   out->status = *status;
-  if (neighbours_ && inputs.command_constraints) {
+  if (inputs.safety_filter != nullptr) {
+    barriers_->report(*status, neighbours_ ? &inputs_.neighbours() : nullptr, &out->barriers);
+  } else if (neighbours_ && inputs.command_constraints) {
     neighbours_->report(inputs_.neighbours(), *status, &out->neighbours);
   }
   fillCounters(now_ns, out);
@@ -201,6 +212,21 @@ const CommandProjection* FollowerCycle::constrainByNeighbours(std::int64_t stamp
   const NeighbourSample& sample = inputs_.neighbours();
   const double ahead = kNanosecond * static_cast<double>(stamp_ns - sample.stamp_ns);
   return &neighbours_->constrain(sample, ahead, settings_.measurement_timeout, target_perimeter);
+}
+
+const SafetyFilter* FollowerCycle::senseBarriers(const GenericDimensions::StateVector& state,
+                                                 const Eigen::Ref<const Eigen::VectorXd>* leader,
+                                                 bool neighbours_given) {
+  const ControllerDesign& design = handover_.current().design();
+  const std::optional<SafetyFilterParameters>& filter = design.parameters.safety_filter;
+  if (!filter || !design.parameters.model.isDoubleIntegrator()) {
+    return nullptr;
+  }
+  const bool with_neighbours = neighbours_given && neighbours_;
+  return &barriers_->sense(
+      state, leader, design.perimeter, filter->rate, with_neighbours ? &*neighbours_ : nullptr,
+      with_neighbours ? &inputs_.neighbours() : nullptr,
+      settings_.neighbours ? settings_.neighbours->parameters.neighbour_acceleration : 0.0);
 }
 
 bool FollowerCycle::turnSlot(std::int64_t stamp_ns, const GenericDimensions::StateVector& state,

@@ -151,7 +151,7 @@ std::string csvPathOf(const std::string& path, const FormationMember& member, bo
 }
 
 /// The first key set in @p scenario that only a sampled run models (the continuous-time loop
-/// has no control period, and no link, headway or feed-forward shaping), or "".
+/// has no control period, and no link, headway, feed-forward shaping or barrier filter), or "".
 std::string sampledOnlyKey(const Scenario& scenario) {
   const ControllerParameters& p = scenario.controller;
   const LinkSpec& link = scenario.link;
@@ -161,6 +161,9 @@ std::string sampledOnlyKey(const Scenario& scenario) {
   }
   if (p.time_headway != 0.0) {
     return "controller.spacing.time_headway";
+  }
+  if (p.safety_filter) {
+    return "controller.safety_filter";
   }
   if (p.feedforward_gain != 1.0) {
     return sharing + "feedforward.gain";

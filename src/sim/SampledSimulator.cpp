@@ -17,13 +17,20 @@
 #include "projection_collision_avoidance/core/NeighbourBarrier.hpp"
 #include "projection_collision_avoidance/core/PaperLaws.hpp"
 #include "projection_collision_avoidance/core/ParameterError.hpp"
+#include "projection_collision_avoidance/core/SafetyFilter.hpp"
 #include "projection_collision_avoidance/core/TurningSlot.hpp"
 #include "projection_collision_avoidance/sim/AgentIntegrator.hpp"
 #include "projection_collision_avoidance/sim/SharedLink.hpp"
 #include "projection_collision_avoidance/sim/VehicleResponse.hpp"
 
+#include "SimulatedFollower.hpp"
+
 namespace projection_collision_avoidance {
 namespace {
+
+using sim_detail::senseBarriers;
+using sim_detail::senseNeighbours;
+using sim_detail::SimulatedFollower;
 
 /// ||p_a - p_b||^2 over the first k (position) entries.
 template <typename Vector>
@@ -87,90 +94,6 @@ class PairMinima {
   std::vector<double> minima_;
   std::vector<bool> linked_;
 };
-
-/// One follower of the run: its controller, its plant and its figures.
-template <typename Dims>
-struct SimulatedFollower {
-  /// @param turning the slot heading's generator of turning slots; null for world slots
-  /// @param path the convoy's parameters of path slots and @p target_state its target's initial
-  /// state; null for other slots
-  SimulatedFollower(const FormationMember& formation_member, const ControllerDesign& member_design,
-                    const AgentModel& model, const SlotHeadingParameters* turning,
-                    const ConvoyParameters* path, const Eigen::VectorXd& target_state,
-                    const WorldSpec& world, double duration, const NeighbourParameters* neighbours,
-                    double perimeter)
-      : member(formation_member),
-        design(member_design),
-        controller(member_design),
-        plant(model, member_design.period, formation_member.initial_state,
-              world.disturbanceOf(formation_member.index, model, duration)),
-        separation(formation_member.separation),
-        command(Dims::InputVector::Zero(model.inputDimension())) {
-    if (turning) {
-      heading.emplace(*turning, member_design.period);
-      heading->reset(formation_member.initial_heading);
-    }
-    if (path) {
-      const int k = model.position_dimension;
-      convoy.emplace(*path, member_design.period, separation.head(k).norm());
-      Eigen::Vector3d position = Eigen::Vector3d::Zero();
-      Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
-      position.head(k) = target_state.head(k);
-      velocity.head(k) = target_state.segment(k, k);
-      convoy->reset(position, velocity, formation_member.path_direction);
-    }
-    if (neighbours) {
-      constraints.emplace(*neighbours, perimeter, model.position_dimension,
-                          member_design.parameters.acceleration_limit);
-    }
-    const VehicleSpec& true_vehicle = world.vehicleOf(member.index);
-    if (world.configured && !true_vehicle.ideal()) {
-      vehicle.emplace(true_vehicle, member_design.period, model.inputDimension());
-    }
-    summary.xi_max = design.xi_max;
-    summary.perimeter = design.perimeter;
-    summary.min_separation = std::numeric_limits<double>::infinity();
-  }
-
-  FormationMember member;
-  ControllerDesign design;
-  FollowerController<Dims> controller;
-  AgentIntegrator<Dims> plant;
-  typename Dims::StateVector separation;  // d_i
-  typename Dims::InputVector command;     // u_i at the current tick
-  std::optional<SlotHeading> heading;     // theta_i (T1) of a turning slot
-  std::optional<ConvoyReference> convoy;  // r_i (C1)-(C3) of a path slot
-  std::optional<VehicleResponse<typename Dims::InputVector>> vehicle;  // a true vehicle apart
-  std::optional<NeighbourConstraints> constraints;  // (N3) with formation.neighbours
-  SimulationSummary summary;
-};
-
-/// (N3): follower @p self's sensed agents this tick, every agent but itself (the leader's state
-/// @p leader, the followers' plants), exact relative states; its target with the perimeter of its
-/// design, alpha ||d_i||.
-template <typename Dims>
-void senseNeighbours(SimulatedFollower<Dims>& self, const typename Dims::StateVector& leader,
-                     const std::vector<SimulatedFollower<Dims>>& followers, int k) {
-  NeighbourConstraints& constraints = *self.constraints;
-  constraints.clear();
-  const auto& own = self.plant.state();
-  auto add = [&](const typename Dims::StateVector& other, int index) {
-    Eigen::Vector3d p = Eigen::Vector3d::Zero();
-    Eigen::Vector3d v = Eigen::Vector3d::Zero();
-    for (int e = 0; e < k; ++e) {
-      p(e) = own(e) - other(e);
-      v(e) = own(k + e) - other(k + e);
-    }
-    constraints.add(p, v,
-                    index == self.member.target ? self.design.perimeter : constraints.perimeter());
-  };
-  add(leader, 0);
-  for (const SimulatedFollower<Dims>& other : followers) {
-    if (other.member.index != self.member.index) {
-      add(other.plant.state(), other.member.index);
-    }
-  }
-}
 
 template <typename Dims>
 FormationSummary runFormation(const Scenario& scenario, const ControllerDesign& scenario_design,
@@ -290,8 +213,17 @@ FormationSummary runFormation(const Scenario& scenario, const ControllerDesign& 
         senseNeighbours(follower, leader.state(), followers, k);
         inputs.command_constraints = &follower.constraints->projection();
       }
+      if (follower.barriers) {
+        Eigen::Vector3d a = Eigen::Vector3d::Zero();
+        a.head(k) = target_acceleration.head(k);
+        senseBarriers(follower, leader.state(), followers, a, share_leader_input,
+                      scenario.formation.neighbours.neighbour_acceleration, k);
+        inputs.safety_filter = &*follower.barriers;
+      }
       const auto& status = follower.controller.step(inputs);
       follower.command = status.command;
+      follower.summary.barrier_ticks += status.command_projected && follower.barriers ? 1 : 0;
+      follower.summary.barrier_infeasible_ticks += status.barrier_infeasible ? 1 : 0;
       if (use_link) {
         link.send(follower.member.index, tick, follower.command);
       }
@@ -386,6 +318,10 @@ std::string formatSummary(const SimulationSummary& summary, double wall_seconds)
   line << "max_xi=" << summary.max_xi << " max_xi_hat=" << summary.max_xi_hat
        << " xi_max=" << summary.xi_max << " min_separation=" << summary.min_separation
        << " time_outside=" << summary.time_outside << " wall_s=" << wall_seconds;
+  if (summary.barrier_filter) {
+    line << " barrier_ticks=" << summary.barrier_ticks
+         << " barrier_infeasible_ticks=" << summary.barrier_infeasible_ticks;
+  }
   return line.str();
 }
 

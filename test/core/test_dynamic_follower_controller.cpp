@@ -35,7 +35,8 @@ void expectSameStatus(const FollowerControllerStatus<DimsA>& a,
                command_saturated, command_rate_limited, fallback, projection_active,
                boundary_correction, measurement_rejected, leader_input_rejected,
                slot_acceleration_rejected, command_overflow, estimate_held, command_projected,
-               constraints_given, constraints_active, constraints_dropped] = a;
+               constraints_given, constraints_active, constraints_dropped, binding_barrier,
+               barrier_infeasible] = a;
   EXPECT_MATRIX_NEAR(command, b.command, tolerance);
   EXPECT_MATRIX_NEAR(baseline_command, b.baseline_command, tolerance);
   EXPECT_MATRIX_NEAR(tracker_command, b.tracker_command, tolerance);
@@ -60,6 +61,8 @@ void expectSameStatus(const FollowerControllerStatus<DimsA>& a,
   EXPECT_EQ(constraints_given, b.constraints_given);
   EXPECT_EQ(constraints_active, b.constraints_active);
   EXPECT_EQ(constraints_dropped, b.constraints_dropped);
+  EXPECT_EQ(binding_barrier, b.binding_barrier);
+  EXPECT_EQ(barrier_infeasible, b.barrier_infeasible);
 }
 
 TEST(DynamicFollowerController, MatchesTheFixedSizeController) {

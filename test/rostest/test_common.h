@@ -85,14 +85,18 @@ struct StatusRecord {
   double max_xi = 0.0;
   double max_xi_hat = 0.0;
   double min_separation = std::numeric_limits<double>::infinity();
-  double max_command = 0.0;     ///< largest ||command|| (m/s^2)
-  bool commands_finite = true;  ///< every command entry finite so far
-  int fallback_ticks = 0;       ///< statuses with fallback set
-  std::set<int> modes;          ///< FollowerStatus::mode values seen
-  double last_time = 0.0;       ///< stamp of the latest status (s)
-  int leader_age_count = 0;     ///< statuses with a finite leader_age
-  double leader_age_sum = 0.0;  ///< s, their sum
-  double max_leader_age = 0.0;  ///< s
+  double max_command = 0.0;                ///< largest ||command|| (m/s^2)
+  bool commands_finite = true;             ///< every command entry finite so far
+  int fallback_ticks = 0;                  ///< statuses with fallback set
+  std::set<int> modes;                     ///< FollowerStatus::mode values seen
+  double last_time = 0.0;                  ///< stamp of the latest status (s)
+  int leader_age_count = 0;                ///< statuses with a finite leader_age
+  double leader_age_sum = 0.0;             ///< s, their sum
+  double max_leader_age = 0.0;             ///< s
+  int barrier_filter_count = 0;            ///< statuses with barrier_filter set
+  int barrier_projected_count = 0;         ///< statuses with barrier_projected set
+  int barrier_infeasible_count = 0;        ///< statuses with barrier_infeasible set
+  std::set<std::string> binding_barriers;  ///< binding_barrier values seen ("" left out)
   FollowerStatus last;
 };
 
@@ -115,6 +119,12 @@ inline void addStatus(const FollowerStatus& msg, StatusRecord* record) {
     ++record->leader_age_count;
     record->leader_age_sum += msg.leader_age;
     record->max_leader_age = std::max(record->max_leader_age, msg.leader_age);
+  }
+  record->barrier_filter_count += msg.barrier_filter ? 1 : 0;
+  record->barrier_projected_count += msg.barrier_projected ? 1 : 0;
+  record->barrier_infeasible_count += msg.barrier_infeasible ? 1 : 0;
+  if (!msg.binding_barrier.empty()) {
+    record->binding_barriers.insert(msg.binding_barrier);
   }
   record->last = msg;
 }

@@ -1,11 +1,13 @@
 #pragma once
 
 #include <limits>
+#include <optional>
 #include <string>
 
 #include <Eigen/Core>
 
 #include "projection_collision_avoidance/core/AgentModel.hpp"
+#include "projection_collision_avoidance/core/SafetyFilter.hpp"
 
 namespace projection_collision_avoidance {
 
@@ -57,6 +59,11 @@ struct ControllerParameters {
   /// [0, I / s] for double integrators (brake the relative velocity with a 1 s time constant),
   /// zero otherwise.
   Eigen::MatrixXd fallback_gain;
+  /// controller.safety_filter: when given, the follower runs the control barrier function filter
+  /// (doc/math.md (B1)-(B3)) in place of the CF tracker: the baseline law's command (tracker
+  /// disabled) filtered by the barrier (B2) on the distance to its target, perimeter alpha ||d||,
+  /// within acceleration_limit. The CF estimator still runs and is reported; it does not act.
+  std::optional<SafetyFilterParameters> safety_filter;
 };
 
 /// The default fallback gain of a k-axis double integrator: [0, k_v I], so that the fallback

@@ -99,6 +99,7 @@ class FollowerController {
     const bool leader_input_known = inputs.leader_input.has_value();
     period_fraction_ = inputs.period_fraction;
     constraints_ = inputs.command_constraints;
+    safety_filter_ = inputs.safety_filter;
     setSlotAcceleration(inputs.slot_acceleration ? &*inputs.slot_acceleration : nullptr);
     return tick(inputs.measurement ? &*inputs.measurement : nullptr,
                 leader_input_known ? *inputs.leader_input : InputVector::Zero(input_matrix_.cols()),
@@ -290,9 +291,6 @@ class FollowerController {
       }
     }
   }
-  /// The fallback's limits: sat() of (10) (saturateCommand(): euclideanNorm(command) <=
-  /// acceleration_limit exactly, no overflow), then the change from the previous tick's command
-  /// limited to jerk_limit T, inside the same ball.
   /// (N3): the command projected onto the given half-spaces and ||u|| <= acceleration_limit,
   /// the less urgent half-spaces dropped when they cannot all be met; the projected command
   /// becomes the rate limit's previous one (the neighbours come before the jerk limit). True
@@ -302,27 +300,63 @@ class FollowerController {
     status_.constraints_given = 0;
     status_.constraints_active = 0;
     status_.constraints_dropped = 0;
+    status_.binding_barrier = -1;
+    status_.barrier_infeasible = false;
     const Eigen::Index m = status_.command.size();
+    if (safety_filter_ != nullptr) {
+      return filterCommand();
+    }
     if (constraints_ == nullptr || constraints_->size() == 0 || m > 3 ||
         constraints_->dimension() != m) {
       return false;
     }
-    Eigen::Vector3d nominal = Eigen::Vector3d::Zero();
-    nominal.head(m) = status_.command;
     const CommandProjectionResult result =
-        constraints_->project(nominal, design_.parameters.acceleration_limit);
-    status_.constraints_given = constraints_->size();
-    status_.constraints_active = result.active;
-    status_.constraints_dropped = result.dropped;
-    if (!result.changed) {
-      return false;
-    }
-    status_.command = result.command.head(m);
-    rate_limiter_.setPrevious(status_.command);
-    status_.command_projected = true;
-    return true;
+        constraints_->project(nominalCommand(), design_.parameters.acceleration_limit);
+    return adoptConstrained(result.command, result.changed, constraints_->size(), result.active,
+                            result.dropped);
   }
 
+  /// (B3): the command, the nominal one, filtered by the barriers of this step and the
+  /// acceleration limit (SafetyFilter); the filtered command becomes the rate limit's previous
+  /// one. True when it moved the command.
+  bool filterCommand() {
+    const Eigen::Index m = status_.command.size();
+    if (safety_filter_->size() == 0 || m > 3 || safety_filter_->problem().dimension() != m) {
+      return false;
+    }
+    const SafetyFilterResult result =
+        safety_filter_->filter(nominalCommand(), design_.parameters.acceleration_limit);
+    status_.binding_barrier = result.active;
+    status_.barrier_infeasible = result.infeasible;
+    return adoptConstrained(result.command, result.changed, safety_filter_->size(),
+                            result.active_count, result.dropped);
+  }
+
+  /// The command of this step so far in 3 entries (0 beyond its size).
+  Eigen::Vector3d nominalCommand() const {
+    Eigen::Vector3d nominal = Eigen::Vector3d::Zero();
+    nominal.head(status_.command.size()) = status_.command;
+    return nominal;
+  }
+
+  /// The counts of a constrained step into the status and, when @p changed, @p command (first
+  /// entries) as the step's command and the rate limit's previous one. Returns @p changed.
+  bool adoptConstrained(const Eigen::Vector3d& command, bool changed, int given, int active,
+                        int dropped) {
+    status_.constraints_given = given;
+    status_.constraints_active = active;
+    status_.constraints_dropped = dropped;
+    if (changed) {
+      status_.command = command.head(status_.command.size());
+      rate_limiter_.setPrevious(status_.command);
+      status_.command_projected = true;
+    }
+    return changed;
+  }
+
+  /// The fallback's limits: sat() of (10) (saturateCommand(): euclideanNorm(command) <=
+  /// acceleration_limit exactly, no overflow), then the change from the previous tick's command
+  /// limited to jerk_limit T, inside the same ball.
   void limitCommand() {
     status_.command_saturated =
         saturateCommand(&status_.command, design_.parameters.acceleration_limit);
@@ -344,6 +378,7 @@ class FollowerController {
   bool slot_acting_ = false;       // u_r given at this step
   double period_fraction_ = 1.0;   // of this step (StepInputs::period_fraction)
   const CommandProjection* constraints_ = nullptr;  // of this step (StepInputs)
+  const SafetyFilter* safety_filter_ = nullptr;     // of this step (StepInputs)
   bool initialized_ = false;
 };
 

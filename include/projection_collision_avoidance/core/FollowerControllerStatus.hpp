@@ -45,6 +45,11 @@ struct FollowerControllerStatus {
   int constraints_given = 0;
   int constraints_active = 0;
   int constraints_dropped = 0;
+  /// With the barrier filter (StepInputs::safety_filter, (B3)): the barrier holding with
+  /// equality at the command (its index, the most urgent first; -1: none), and whether the
+  /// barriers and the acceleration limit could not all be met this tick.
+  int binding_barrier = -1;
+  bool barrier_infeasible = false;
 
   FollowerControllerStatus() = default;
   /// The same status in other (compatible) dimensions, e.g. fixed to bounded: the one place that
@@ -79,6 +84,8 @@ struct FollowerControllerStatus {
     constraints_given = other.constraints_given;
     constraints_active = other.constraints_active;
     constraints_dropped = other.constraints_dropped;
+    binding_barrier = other.binding_barrier;
+    barrier_infeasible = other.barrier_infeasible;
     return *this;
   }
 };

@@ -5,6 +5,7 @@
 #include <Eigen/Core>
 
 #include "projection_collision_avoidance/core/CommandProjection.hpp"
+#include "projection_collision_avoidance/core/SafetyFilter.hpp"
 #include "projection_collision_avoidance/core/TypeDefs.hpp"
 
 namespace projection_collision_avoidance {
@@ -30,6 +31,9 @@ struct StepInputs {
   /// Half-spaces g_j^T u >= b_j the command must lie in (the neighbours' barriers, (N3)), most
   /// important first, of the command's size; null or empty: none. Not owned.
   const CommandProjection* command_constraints = nullptr;
+  /// The barriers (B2) of this step (controller.safety_filter); when given, the command is
+  /// filtered by it (B3) and command_constraints is not used. Not owned.
+  const SafetyFilter* safety_filter = nullptr;
 };
 
 /// StepInputs of any sizes, the argument of DynamicFollowerController::step(): each entry a
@@ -41,6 +45,7 @@ struct DynamicStepInputs {
   std::optional<Eigen::Ref<const Eigen::VectorXd>> slot_acceleration{};  ///< u_r (m/s^2)
   double period_fraction = 1.0;  ///< Delta t / T since the previous step (StepInputs)
   const CommandProjection* command_constraints = nullptr;  ///< (N3), as in StepInputs
+  const SafetyFilter* safety_filter = nullptr;             ///< (B3), as in StepInputs
 };
 
 }  // namespace projection_collision_avoidance

@@ -13,6 +13,7 @@
 #include "projection_collision_avoidance/core/FollowerMode.hpp"
 #include "projection_collision_avoidance/core/TurningSlot.hpp"
 #include "projection_collision_avoidance/core/TypeDefs.hpp"
+#include "projection_collision_avoidance/cycle/BarrierSensing.hpp"
 #include "projection_collision_avoidance/cycle/ControllerHandover.hpp"
 #include "projection_collision_avoidance/cycle/InputTimeline.hpp"
 #include "projection_collision_avoidance/cycle/LatchedInputs.hpp"
@@ -94,6 +95,7 @@ struct FollowerCycleOutput {
   double time_jump = 0.0;        ///< s (negative): the jump seen at this tick, else 0
   double stall = 0.0;            ///< s: a tick this late began a wait for input, else 0
   NeighbourReport neighbours;    ///< formation.neighbours: what the sensed agents did
+  BarrierReport barriers;        ///< controller.safety_filter: what the barriers (B2) did
 };
 
 /// The follower's control cycle without ROS: it reads the latest accepted inputs from lock-free
@@ -246,6 +248,12 @@ class FollowerCycle {
   /// section, and when that array is stale (the step then brakes: mode measurement_lost).
   const CommandProjection* constrainByNeighbours(std::int64_t stamp_ns, double target_perimeter,
                                                  FollowerCycleOutput* out);
+  /// controller.safety_filter (of the design in force): the barriers of a measured step from the
+  /// relative state @p state, the target's acceleration @p leader when known (null otherwise) and
+  /// the step's neighbours; nullptr without the filter.
+  const SafetyFilter* senseBarriers(const GenericDimensions::StateVector& state,
+                                    const Eigen::Ref<const Eigen::VectorXd>* leader,
+                                    bool neighbours_given);
   /// The counters and the design in force into @p out (whether or not a step ran).
   void fillCounters(std::int64_t now_ns, FollowerCycleOutput* out) const;
   /// Notes ROS time @p now_ns: a jump back is counted, and the stamps start afresh.
@@ -258,6 +266,7 @@ class FollowerCycle {
   bool heading_started_ = false;                      ///< theta(0) set by the first step
   std::optional<PathSlot> path_slot_;                 ///< r (C1)-(C5) of a path slot
   std::optional<NeighbourSensing> neighbours_;        ///< (N1)-(N3) with formation.neighbours
+  std::optional<BarrierSensing> barriers_;            ///< (B2) with controller.safety_filter
   GenericDimensions::InputVector slot_acceleration_;  ///< u_r (T3) of the step
   GenericDimensions::InputVector own_position_;       ///< path slots: own point at the stamp
   double period_ = 0.0;

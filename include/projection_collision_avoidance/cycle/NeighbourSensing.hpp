@@ -73,6 +73,10 @@ class NeighbourSensing {
   /// @p report (whose fresh and age the caller fills), with the agents' ids from @p sample.
   void report(const NeighbourSample& sample, const DynamicFollowerStatus& status,
               NeighbourReport* report) const;
+  /// The half-spaces of the last constrain(): the kept ones, most urgent first.
+  const NeighbourConstraints& constraints() const { return constraints_; }
+  /// Agent @p j (< the sample's count) of the last constrain(), at the step's stamp.
+  const NeighbourMark& mark(int j) const { return marks_[static_cast<std::size_t>(j)]; }
 
  private:
   NeighbourConstraints constraints_;

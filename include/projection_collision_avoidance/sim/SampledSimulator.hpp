@@ -44,6 +44,11 @@ struct SimulationSummary {
   double time_outside = 0.0;             ///< time with ||xi|| > xi_max (s)
   double max_boundary_correction = 0.0;  ///< largest RK4 excess removed by the estimator (m)
   long ticks = 0;                        ///< control ticks simulated
+  /// With controller.safety_filter (barrier_filter): ticks the barrier (B2) moved the command,
+  /// and ticks it and the acceleration limit could not both be met (B3).
+  bool barrier_filter = false;
+  long barrier_ticks = 0;
+  long barrier_infeasible_ticks = 0;
 };
 
 /// The figures of a formation's run.
@@ -92,7 +97,8 @@ FormationSummary simulateFormation(const Scenario& scenario,
 SimulationSummary simulate(const Scenario& scenario, const SampleObserver& observer = {});
 
 /// The summary line "max_xi=.. max_xi_hat=.. xi_max=.. min_separation=.. time_outside=..
-/// wall_s=.." (values in %.9g), with @p wall_seconds the run's wall-clock time.
+/// wall_s=.." (values in %.9g), with @p wall_seconds the run's wall-clock time; with the barrier
+/// filter, " barrier_ticks=.. barrier_infeasible_ticks=.." after it.
 std::string formatSummary(const SimulationSummary& summary, double wall_seconds);
 
 }  // namespace projection_collision_avoidance

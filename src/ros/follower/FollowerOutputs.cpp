@@ -233,6 +233,10 @@ void FollowerOutputs::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat
       neighbours.smallest_barrier < 0.0) {
     status.mergeSummary(DiagnosticStatus::ERROR, "inside a neighbour's perimeter");
   }
+  if (s.barriers.given && s.barriers.infeasible) {
+    status.mergeSummary(DiagnosticStatus::WARN,
+                        "barrier filter infeasible: the acceleration limit cannot meet a barrier");
+  }
   if (!inputs.neighbour_rejection.empty()) {
     status.mergeSummary(DiagnosticStatus::WARN,
                         "rejecting neighbour arrays: " + inputs.neighbour_rejection);
@@ -292,6 +296,15 @@ void FollowerOutputs::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat
     status.add("nearest_neighbour (m)", neighbours.nearest);
     status.add("neighbour_barrier (m/s)", neighbours.smallest_barrier);
     status.add("binding_neighbour", std::string(neighbours.binding_id.data()));
+  }
+  const BarrierReport& barriers = s.barriers;
+  if (barriers.configured) {
+    status.add("barriers", barriers.barriers);
+    status.add("barriers_active", barriers.active);
+    status.add("barriers_dropped", barriers.dropped);
+    status.add("barrier_infeasible", barriers.infeasible ? "true" : "false");
+    status.add("target_barrier (m^2)", barriers.target_barrier);
+    status.add("binding_barrier", std::string(barriers.binding_id.data()));
   }
 }
 

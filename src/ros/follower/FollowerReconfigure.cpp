@@ -58,6 +58,11 @@ void FollowerReconfigure::onReconfigure(FollowerConfig& config, uint32_t /*level
         throw ParameterError(name, "must be finite, got " + std::to_string(value));
       }
     }
+    if (candidate.tracker_enabled && candidate.safety_filter) {
+      throw ParameterError("tracker_enabled",
+                           "must be false with controller.safety_filter (the barrier filter's "
+                           "nominal command is the baseline law)");
+    }
     if (config.tracker_natural_frequency < 0.0) {
       throw ParameterError("tracker_natural_frequency",
                            "must be >= 0 (0: the scenario's gain), got " +

@@ -75,6 +75,17 @@ FollowerStatus toStatusMsg(const FollowerCycleOutput& out, const FollowerInputSt
     msg.neighbour_barrier = n.smallest_barrier;
     msg.binding_neighbour = n.binding_id.data();
   }
+  const BarrierReport& b = out.barriers;
+  msg.barrier_filter = b.configured;
+  if (b.configured) {
+    msg.barriers = static_cast<uint32_t>(b.barriers);
+    msg.barriers_active = static_cast<uint32_t>(b.active);
+    msg.barriers_dropped = static_cast<uint32_t>(b.dropped);
+    msg.barrier_projected = b.projected;
+    msg.barrier_infeasible = b.infeasible;
+    msg.target_barrier = b.target_barrier;
+    msg.binding_barrier = b.binding_id.data();
+  }
   return msg;
 }
 
