@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "projection_collision_avoidance/core/BallConstraint.hpp"
 #include "projection_collision_avoidance/core/ParameterError.hpp"
 
 namespace projection_collision_avoidance {
@@ -38,6 +39,21 @@ Eigen::Vector3d singleBarrierCommand(const Eigen::Vector3d& nominal, const Eigen
   }
   return nominal + (shortfall / norm2) * normal;  // (B3), one barrier
 }
+
+namespace {
+
+/// The command of norm @p limit (m/s^2) along the nonzero finite @p direction, at any scale of
+/// it: normalised by its largest entry first, so that neither its norm overflows nor its square
+/// underflows, and clamped so that rounding leaves euclideanNorm() <= limit.
+Eigen::Vector3d bestEffort(const Eigen::Vector3d& direction, double limit) {
+  Eigen::Vector3d u = direction / direction.cwiseAbs().maxCoeff();
+  u /= euclideanNorm(u);
+  u *= limit;
+  clampNorm(u, limit);
+  return u;
+}
+
+}  // namespace
 
 SafetyFilter::SafetyFilter(int dimension) : qp_(dimension) {}
 
@@ -77,7 +93,7 @@ SafetyFilterResult SafetyFilter::filter(const Eigen::Vector3d& nominal,
   // The most urgent barrier dropped: alone it is out of reach within the limit (the ball is
   // always kept). Its best effort, the command of the limit's norm along g_0.
   if ((qp.dropped_mask & 1U) != 0U) {
-    result.command = (acceleration_limit / first_normal_.norm()) * first_normal_;
+    result.command = bestEffort(first_normal_, acceleration_limit);
     result.changed = true;
     result.active = -1;
     result.active_count = 0;

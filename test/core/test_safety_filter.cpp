@@ -10,6 +10,7 @@
 #include <Eigen/Core>
 #include <gtest/gtest.h>
 
+#include "projection_collision_avoidance/core/BallConstraint.hpp"
 #include "projection_collision_avoidance/core/ParameterError.hpp"
 #include "projection_collision_avoidance/core/SafetyFilter.hpp"
 
@@ -173,6 +174,24 @@ TEST(SafetyFilter, TooFastForTheLimitIsInfeasibleAndBrakesAtTheLimit) {
   EXPECT_EQ(s.dropped, 1);
   EXPECT_EQ(s.active, 0);
   EXPECT_LT((s.command - Vector3(1.0, 0.3, 0.0)).norm(), 1e-12);
+}
+
+TEST(SafetyFilter, BestEffortKeepsTheLimitAtEveryScaleOfTheBarrier) {
+  // g_0 = s (1, 2) with b_0 = 3 s, out of reach of a_max = 1 at any scale s: the best effort is
+  // (1, 2) / sqrt(5), also where ||g_0|| overflows or its square underflows.
+  const Vector3 expected = Vector3(1.0, 2.0, 0.0) / std::sqrt(5.0);
+  for (const double s : {1e-170, 1e-160, 1e-100, 1e-3, 1.0, 3.0, 1e100, 1e160, 1e300}) {
+    SafetyFilter filter(2);
+    BarrierConstraint c;
+    c.normal << s, 2.0 * s, 0.0;
+    c.bound = 3.0 * s;
+    ASSERT_TRUE(filter.add(c)) << s;
+    const SafetyFilterResult r = filter.filter(Vector3::Zero(), 1.0);
+    EXPECT_TRUE(r.infeasible) << s;
+    EXPECT_TRUE(r.command.allFinite()) << s;
+    EXPECT_LE(euclideanNorm(r.command), 1.0) << s;
+    EXPECT_LT((r.command - expected).norm(), 1e-15) << s;
+  }
 }
 
 TEST(SafetyFilterParameters, ValidateNamesTheKey) {
