@@ -9,7 +9,7 @@ function(pca_schedule_tests)
     "platoon|paper_chain_20" 90
     "formation|vehicles" 45
     "invalid_parameters|formation_launch|hostile" 30
-    "compare_neighbours|compare_qp" 25
+    "compare_neighbours|compare_qp|compare_barrier_filter" 25
     "plant_vehicles|faults|time_faults|paper_run|compare_with_reference" 15)
   set(serial "test_periodic_thread|test_shared_ticker|measurement_flood|follower_loop")
   get_property(tests DIRECTORY PROPERTY TESTS)

@@ -91,10 +91,13 @@ SafetyFilterResult SafetyFilter::filter(const Eigen::Vector3d& nominal,
     }
   }
   // The most urgent barrier dropped: alone it is out of reach within the limit (the ball is
-  // always kept). Its best effort, the command of the limit's norm along g_0.
+  // always kept). Its best effort, the command of the limit's norm along g_0; a nominal command
+  // already that one within the QP's tolerance (saturated along g_0) is kept as it is.
   if ((qp.dropped_mask & 1U) != 0U) {
-    result.command = bestEffort(first_normal_, acceleration_limit);
-    result.changed = true;
+    const Eigen::Vector3d best = bestEffort(first_normal_, acceleration_limit);
+    result.changed = euclideanNorm(best - u) >
+                     CommandProjection::kFeasibilityTolerance * acceleration_limit;
+    result.command = result.changed ? best : u;
     result.active = -1;
     result.active_count = 0;
     result.limit_active = true;

@@ -191,7 +191,22 @@ TEST(SafetyFilter, BestEffortKeepsTheLimitAtEveryScaleOfTheBarrier) {
     EXPECT_TRUE(r.command.allFinite()) << s;
     EXPECT_LE(euclideanNorm(r.command), 1.0) << s;
     EXPECT_LT((r.command - expected).norm(), 1e-15) << s;
+    EXPECT_TRUE(r.changed) << s;
   }
+  // A nominal command that is already the best effort, to the QP's tolerance, is not moved (nor
+  // counted as moved).
+  SafetyFilter line(1);
+  BarrierConstraint c;
+  c.normal << 2.0, 0.0, 0.0;
+  c.bound = 5.0;  // u >= 2.5, out of reach of a_max = 1
+  ASSERT_TRUE(line.add(c));
+  const SafetyFilterResult r = line.filter(Vector3(1.0, 0.0, 0.0), 1.0);
+  EXPECT_TRUE(r.infeasible);
+  EXPECT_FALSE(r.changed);
+  EXPECT_EQ(r.command, Vector3(1.0, 0.0, 0.0));
+  const Vector3 below(1.0 - 1e-14, 0.0, 0.0);  // an ulp or so short of a_max: kept as it is
+  EXPECT_EQ(line.filter(below, 1.0).command, below);
+  EXPECT_TRUE(line.filter(Vector3(0.5, 0.0, 0.0), 1.0).changed);
 }
 
 TEST(SafetyFilterParameters, ValidateNamesTheKey) {

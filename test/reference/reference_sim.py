@@ -135,6 +135,10 @@ rows of the CSV of cf_sim; with turning slots the CSV adds cf_sim's columns
 slot_heading, slot_yaw_rate, slot_yaw_acceleration, slot_p_* (R(theta) d_p) and
 u_slot_* (u_r).
 
+The barrier filter: with controller.safety_filter (the tracker off) the sampled loop replaces
+the projection (N3) by the filter (B1)-(B3) of doc/math.md, barrier_reference.py; its summary
+line adds barrier_ticks and barrier_infeasible_ticks, its CSV barrier_infeasible.
+
 Usage::
 
     reference_sim.py SCENARIO.yaml [--set key=value]... [--method LSODA]
@@ -162,6 +166,9 @@ import numpy as np
 import yaml
 from scipy.integrate import solve_ivp
 from scipy.linalg import expm, solve_continuous_lyapunov
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import barrier_reference  # noqa: E402  (beside this file)
 
 PROG = "reference_sim"
 
@@ -206,6 +213,7 @@ SCHEMA = {
         "leader_information": {"command": None, "estimator": None, "disturbance": None},
         "acceleration_limit": None,     # sampled loop only (world, neighbours, --sampled)
         "jerk_limit": None,             # sampled loop only
+        "safety_filter": barrier_reference.SCHEMA,   # sampled loop only (barrier_reference.py)
     },
     "leader": {
         "initial_state": None,
@@ -427,6 +435,7 @@ class Scenario:
     world: World = None             # the section world (sampled loop); None without it
     substeps: int = 1               # controller.estimator.substeps (sampled loop)
     sampled: bool = False           # run the sampled loop (world, neighbours or --sampled)
+    safety_filter: float = None     # controller.safety_filter's rate (1/s); None without it
 
     def __post_init__(self):
         self.n, self.m = self.B.shape
@@ -800,15 +809,18 @@ def build_scenario(raw, sampled=False):
     """Validate the raw YAML tree and return a Scenario.
 
     The loop is the sampled one (Scenario.sampled) with sampled set (--sampled), a section
-    world or formation.neighbours; else the continuous one, which refuses
-    controller.acceleration_limit and controller.jerk_limit (defined per control period here).
+    world, formation.neighbours or controller.safety_filter; else the continuous one, which
+    refuses controller.acceleration_limit and controller.jerk_limit (defined per control period
+    here).
     """
     if not isinstance(raw, dict):
         raise ScenarioError("the scenario must be a YAML mapping")
     check_keys(raw, SCHEMA)
     fnode = raw.get("formation")
+    cnode = raw.get("controller")
     sampled = bool(sampled or "world" in raw
-                   or (isinstance(fnode, dict) and "neighbours" in fnode))
+                   or (isinstance(fnode, dict) and "neighbours" in fnode)
+                   or (isinstance(cnode, dict) and "safety_filter" in cnode))
 
     model = get(raw, "model", "")
     mtype = get(model, "type", "model")
@@ -900,6 +912,8 @@ def build_scenario(raw, sampled=False):
     S21 = as_matrix(trk.get("reference_gain", 0), "controller.tracker.reference_gain", m, p)
     if tracker and not is_hurwitz(A - B @ G @ C - B @ Ge @ C):
         raise ScenarioError("controller.tracker.gain: A_c - B G_e C is not Hurwitz")
+    safety_filter = barrier_reference.parse(ctl.get("safety_filter"), tracker,
+                                            double_integrator, ScenarioError)
 
     info = ctl.get("leader_information") or {}
     info_command = as_bool(info.get("command", False), "controller.leader_information.command")
@@ -970,7 +984,7 @@ def build_scenario(raw, sampled=False):
                     disturbances=disturbances, duration=duration, formation=formation,
                     acceleration_limit=limits["acceleration_limit"],
                     jerk_limit=limits["jerk_limit"], world=world, substeps=substeps or 1,
-                    sampled=sampled)
+                    sampled=sampled, safety_filter=safety_filter)
 
 
 def load_scenario(path, overrides=(), sampled=False):
@@ -1718,7 +1732,8 @@ def simulate_sampled(sc):
            (("xi", n), ("xi_hat", n), ("x", n), ("target", n), ("u", m), ("u_baseline", m),
             ("u_tracker", m), ("u_applied", m), ("noise", n))}
     rec_f = {key: np.zeros((N + 1, F)) for key in ("f", "kept", "dropped", "projected",
-                                                   "saturated", "rate_limited")}
+                                                   "saturated", "rate_limited",
+                                                   "barrier_infeasible")}
     pair_min = np.full((F + 1, F + 1), math.inf)
     leader_told = np.where(targets == 0, 1.0, 0.0)[:, None]
 
@@ -1771,7 +1786,17 @@ def simulate_sampled(sc):
             u[rate_limited] = (U_prev[rate_limited] + du[rate_limited]
                                * (sc.jerk_limit * T / dn[rate_limited])[:, None])
         projected = np.zeros(F, dtype=bool)
-        if nb is not None:
+        if sc.safety_filter is not None:          # (B1)-(B3), barrier_reference.py
+            sensed = None
+            if nb is not None:
+                _, _, urgency, dist, valid = neighbour_halfspaces(
+                    nb, X[:, :k], X[:, k:2 * k], targets, own_perimeter, sc.acceleration_limit)
+                sensed = (nb, valid, urgency, dist)
+            u, projected, infeasible = barrier_reference.filter_commands(
+                sc, sc.safety_filter, u, X, targets, own_perimeter, a1,
+                sc.info_command or sc.info_estimator, sensed, nearest_point, project_command)
+            rec_f["barrier_infeasible"][tick] = infeasible
+        elif nb is not None:
             amax = sc.acceleration_limit
             normals, bounds, urgency, dist, valid = neighbour_halfspaces(
                 nb, X[:, :k], X[:, k:2 * k], targets, own_perimeter, amax)
@@ -1873,6 +1898,8 @@ def simulate_sampled(sc):
             cols[f"noise_{e}"] = rec["noise"][:, i, e]
         for name in ("saturated", "rate_limited", "projected", "kept", "dropped"):
             cols[name] = rec_f[name][:, i]
+        if sc.safety_filter is not None:
+            cols["barrier_infeasible"] = rec_f["barrier_infeasible"][:, i]
         runs.append((names[i], cols, xi_max[i]))
     return runs, targets, pair_min, wall
 
@@ -1914,7 +1941,12 @@ def run_sampled(sc, csv_path=None):
                    "min_separation": float(np.min(cols["separation"])),
                    "time_outside": int(np.count_nonzero(norm_xi > xi_max)) / sc.control_rate,
                    "wall_s": wall}
-        line = " ".join(f"{key}={value:.9g}" for key, value in figures.items())
+        if sc.safety_filter is not None:
+            figures["barrier_ticks"] = int(np.count_nonzero(cols["projected"]))
+            figures["barrier_infeasible_ticks"] = int(
+                np.count_nonzero(cols["barrier_infeasible"]))
+        line = " ".join(f"{key}={value}" if isinstance(value, int) else f"{key}={value:.9g}"
+                        for key, value in figures.items())
         target = "leader" if targets[i] == 0 else f"follower_{targets[i]}"
         print(f"{name} target={target} {line}" if name else line, flush=True)
     if sc.formation is not None:
