@@ -30,8 +30,6 @@ One line per case, then ``N passed, M failed``; exit status 1 if any failed, 2 f
 line. --xunit writes a JUnit XML file. Runtime about 30 s with --jobs 2.
 """
 
-import argparse
-import concurrent.futures
 import os
 import sys
 import tempfile
@@ -41,7 +39,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from compare_common import run_tool, write_xunit  # noqa: E402  (beside this file)
+from compare_common import case_parser, run_both, run_cases  # noqa: E402  (beside this file)
 from compare_neighbours import columns, difference, read_csv  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
@@ -166,13 +164,10 @@ def check_case(case, cf_sim, reference, scenarios_dir, tolerance=None, keep=None
     with tempfile.TemporaryDirectory(prefix="compare_barrier_") as tmp:
         work = Path(keep) / case.name if keep else Path(tmp)
         work.mkdir(parents=True, exist_ok=True)
-        with concurrent.futures.ThreadPoolExecutor(max_workers=2) as pool:
-            jobs = [pool.submit(run_tool, tool, [scenario, "--csv", work / f"{label}.csv"],
-                                case.overrides, parse_summaries, (ValueError, KeyError))
-                    for tool, label in ((cf_sim, "cf_sim"), (reference, "reference"))]
-            (cf, cf_err), (ref, ref_err) = jobs[0].result(), jobs[1].result()
-        if cf_err or ref_err:
-            return False, f"FAIL {case.name}: " + "; ".join(e for e in (cf_err, ref_err) if e)
+        cf, ref, error = run_both(cf_sim, reference, scenario, work, case.overrides,
+                                  parse_summaries)
+        if error:
+            return False, f"FAIL {case.name}: {error}"
         problems, worst, counts = [], 0.0, []
         if set(cf) != set(ref):
             problems.append(f"lines differ: cf_sim {sorted(cf)}, reference {sorted(ref)}")
@@ -207,45 +202,13 @@ def check_case(case, cf_sim, reference, scenarios_dir, tolerance=None, keep=None
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(prog="compare_barrier_filter.py",
-                                 description="Compare cf_sim's barrier filter with "
-                                             "reference_sim.py (see the module docstring).")
-    ap.add_argument("--cf-sim", required=True, metavar="PATH")
-    ap.add_argument("--scenarios-dir", required=True, type=Path, metavar="DIR")
-    ap.add_argument("--reference", default=str(DEFAULT_REFERENCE), metavar="PATH")
-    ap.add_argument("--tolerance", type=float, metavar="M")
-    ap.add_argument("--case", action="append", default=[], metavar="NAME")
-    ap.add_argument("--jobs", type=int, default=2, help="cases run in parallel")
-    ap.add_argument("--xunit", metavar="FILE", help="also write a JUnit XML file")
-    ap.add_argument("--keep", metavar="DIR", help="keep the CSVs in DIR/<case>/")
-    ap.add_argument("--list", action="store_true", help="list the cases and exit")
-    args = ap.parse_args(argv)
-    if args.list:
-        for case in CASES:
-            print(f"{case.name:<22} {case.scenario:<20} {case.note}")
-            for assignment in case.overrides:
-                print(f"{'':<22}   --set {assignment}")
-        return 0
-    unknown = sorted(set(args.case) - {c.name for c in CASES})
-    if unknown:
-        print(f"compare_barrier_filter: error: unknown case {', '.join(unknown)}",
-              file=sys.stderr)
-        return 2
-    cases = [c for c in CASES if not args.case or c.name in args.case]
-    with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, args.jobs)) as pool:
-        futures = {c.name: pool.submit(check_case, c, args.cf_sim, args.reference,
-                                       args.scenarios_dir, args.tolerance, args.keep)
-                   for c in cases}
-        results = []
-        for case in cases:
-            ok, line = futures[case.name].result()
-            print(line, flush=True)
-            results.append((case.name, ok, line))
-    failed = sum(1 for _, ok, _ in results if not ok)
-    print(f"{len(results) - failed} passed, {failed} failed")
-    if args.xunit:
-        write_xunit(args.xunit, "compare_barrier_filter", results)
-    return 1 if failed else 0
+    args = case_parser("compare_barrier_filter.py", "Compare cf_sim's barrier filter with "
+                       "reference_sim.py (see the module docstring).", DEFAULT_REFERENCE
+                       ).parse_args(argv)
+    return run_cases("compare_barrier_filter", CASES, args,
+                     lambda c: check_case(c, args.cf_sim, args.reference, args.scenarios_dir,
+                                          args.tolerance, args.keep),
+                     lambda c: f"{c.name:<22} {c.scenario:<20} {c.note}", 22)
 
 
 if __name__ == "__main__":

@@ -47,8 +47,6 @@ line. --xunit writes a JUnit XML file as compare_with_reference.py does. A tool 
 every difference is then 0).
 """
 
-import argparse
-import concurrent.futures
 import math
 import os
 import sys
@@ -59,7 +57,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from compare_common import run_tool, write_xunit  # noqa: E402  (beside this file)
+from compare_common import case_parser, run_both, run_cases  # noqa: E402  (beside this file)
 
 HERE = Path(__file__).resolve().parent
 DEFAULT_REFERENCE = HERE / "reference_sim.py"
@@ -213,15 +211,10 @@ def check_case(case, cf_sim, reference, scenarios_dir, tolerance=None, keep=None
     with tempfile.TemporaryDirectory(prefix="compare_neighbours_") as tmp:
         work = Path(keep) / case.name if keep else Path(tmp)
         work.mkdir(parents=True, exist_ok=True)
-        with concurrent.futures.ThreadPoolExecutor(max_workers=2) as pool:
-            cf_job = pool.submit(run_tool, cf_sim, [scenario, "--csv", work / "cf_sim.csv"],
-                                 case.overrides, parse_summaries, (ValueError, KeyError))
-            ref_job = pool.submit(run_tool, reference,
-                                  [scenario, "--csv", work / "reference.csv"],
-                                  case.overrides, parse_summaries, (ValueError, KeyError))
-            (cf, cf_err), (ref, ref_err) = cf_job.result(), ref_job.result()
-        if cf_err or ref_err:
-            return False, f"FAIL {case.name}: " + "; ".join(e for e in (cf_err, ref_err) if e)
+        cf, ref, error = run_both(cf_sim, reference, scenario, work, case.overrides,
+                                  parse_summaries)
+        if error:
+            return False, f"FAIL {case.name}: {error}"
         (cf_f, cf_form), (ref_f, ref_form) = cf, ref
         problems = []
         if set(cf_f) != set(ref_f):
@@ -263,47 +256,15 @@ def check_case(case, cf_sim, reference, scenarios_dir, tolerance=None, keep=None
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(prog="compare_neighbours.py",
-                                 description="Compare cf_sim's world and neighbours with "
-                                             "reference_sim.py (see the module docstring).")
-    ap.add_argument("--cf-sim", required=True, metavar="PATH")
-    ap.add_argument("--scenarios-dir", required=True, type=Path, metavar="DIR")
-    ap.add_argument("--reference", default=str(DEFAULT_REFERENCE), metavar="PATH")
-    ap.add_argument("--tolerance", type=float, metavar="M",
-                    help="tolerance (m) for every case instead of each case's own")
-    ap.add_argument("--case", action="append", default=[], metavar="NAME")
-    ap.add_argument("--jobs", type=int, default=2, help="cases run in parallel")
-    ap.add_argument("--xunit", metavar="FILE", help="also write a JUnit XML file")
-    ap.add_argument("--keep", metavar="DIR", help="keep the CSVs in DIR/<case>/")
-    ap.add_argument("--list", action="store_true", help="list the cases and exit")
-    args = ap.parse_args(argv)
-    if args.list:
-        for case in CASES:
-            print(f"{case.name:<34} {case.scenario:<20} {case.tolerance:<6g} {case.note}")
-            for assignment in case.overrides:
-                print(f"{'':<34}   --set {assignment}")
-        return 0
-    unknown = sorted(set(args.case) - {c.name for c in CASES})
-    if unknown:
-        print(f"compare_neighbours: error: unknown case {', '.join(unknown)}", file=sys.stderr)
-        return 2
-    cases = [c for c in CASES if not args.case or c.name in args.case]
+    args = case_parser("compare_neighbours.py", "Compare cf_sim's world and neighbours with "
+                       "reference_sim.py (see the module docstring).", DEFAULT_REFERENCE
+                       ).parse_args(argv)
     # The slowest first, so that two jobs finish together.
-    order = sorted(cases, key=lambda c: c.scenario != CROWD16)
-    with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, args.jobs)) as pool:
-        futures = {c.name: pool.submit(check_case, c, args.cf_sim, args.reference,
-                                       args.scenarios_dir, args.tolerance, args.keep)
-                   for c in order}
-        results = []
-        for case in cases:
-            ok, line = futures[case.name].result()
-            print(line, flush=True)
-            results.append((case.name, ok, line))
-    failed = sum(1 for _, ok, _ in results if not ok)
-    print(f"{len(results) - failed} passed, {failed} failed")
-    if args.xunit:
-        write_xunit(args.xunit, "compare_neighbours", results)
-    return 1 if failed else 0
+    return run_cases("compare_neighbours", CASES, args,
+                     lambda c: check_case(c, args.cf_sim, args.reference, args.scenarios_dir,
+                                          args.tolerance, args.keep),
+                     lambda c: f"{c.name:<34} {c.scenario:<20} {c.tolerance:<6g} {c.note}", 34,
+                     first=lambda c: c.scenario == CROWD16)
 
 
 if __name__ == "__main__":
