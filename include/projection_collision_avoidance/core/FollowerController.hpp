@@ -4,6 +4,7 @@
 #include "projection_collision_avoidance/core/BallConstraint.hpp"
 #include "projection_collision_avoidance/core/CollisionFreeEstimator.hpp"
 #include "projection_collision_avoidance/core/CommandRateLimiter.hpp"
+#include "projection_collision_avoidance/core/ConstrainedCommand.hpp"
 #include "projection_collision_avoidance/core/ControllerDesign.hpp"
 #include "projection_collision_avoidance/core/FollowerControllerStatus.hpp"
 #include "projection_collision_avoidance/core/PaperLaws.hpp"
@@ -56,7 +57,8 @@ class FollowerController {
                             design.parameters.model.inputDimension()),
         rate_limiter_(design.parameters.jerk_limit, design.period,
                       design.parameters.acceleration_limit,
-                      design.parameters.model.inputDimension()) {
+                      design.parameters.model.inputDimension()),
+        constrained_(design.parameters.acceleration_limit) {
     status_.command = InputVector::Zero(design.parameters.model.inputDimension());
     status_.baseline_command = status_.command;
     status_.tracker_command = status_.command;
@@ -291,67 +293,9 @@ class FollowerController {
       }
     }
   }
-  /// (N3): the command projected onto the given half-spaces and ||u|| <= acceleration_limit,
-  /// the less urgent half-spaces dropped when they cannot all be met; the projected command
-  /// becomes the rate limit's previous one (the neighbours come before the jerk limit). True
-  /// when it moved the command.
+  /// (N3) or (B3) on the command of this step (ConstrainedCommand); true when it moved it.
   bool constrainCommand() {
-    status_.command_projected = false;
-    status_.constraints_given = 0;
-    status_.constraints_active = 0;
-    status_.constraints_dropped = 0;
-    status_.binding_barrier = -1;
-    status_.barrier_infeasible = false;
-    const Eigen::Index m = status_.command.size();
-    if (safety_filter_ != nullptr) {
-      return filterCommand();
-    }
-    if (constraints_ == nullptr || constraints_->size() == 0 || m > 3 ||
-        constraints_->dimension() != m) {
-      return false;
-    }
-    const CommandProjectionResult result =
-        constraints_->project(nominalCommand(), design_.parameters.acceleration_limit);
-    return adoptConstrained(result.command, result.changed, constraints_->size(), result.active,
-                            result.dropped);
-  }
-
-  /// (B3): the command, the nominal one, filtered by the barriers of this step and the
-  /// acceleration limit (SafetyFilter); the filtered command becomes the rate limit's previous
-  /// one. True when it moved the command.
-  bool filterCommand() {
-    const Eigen::Index m = status_.command.size();
-    if (safety_filter_->size() == 0 || m > 3 || safety_filter_->problem().dimension() != m) {
-      return false;
-    }
-    const SafetyFilterResult result =
-        safety_filter_->filter(nominalCommand(), design_.parameters.acceleration_limit);
-    status_.binding_barrier = result.active;
-    status_.barrier_infeasible = result.infeasible;
-    return adoptConstrained(result.command, result.changed, safety_filter_->size(),
-                            result.active_count, result.dropped);
-  }
-
-  /// The command of this step so far in 3 entries (0 beyond its size).
-  Eigen::Vector3d nominalCommand() const {
-    Eigen::Vector3d nominal = Eigen::Vector3d::Zero();
-    nominal.head(status_.command.size()) = status_.command;
-    return nominal;
-  }
-
-  /// The counts of a constrained step into the status and, when @p changed, @p command (first
-  /// entries) as the step's command and the rate limit's previous one. Returns @p changed.
-  bool adoptConstrained(const Eigen::Vector3d& command, bool changed, int given, int active,
-                        int dropped) {
-    status_.constraints_given = given;
-    status_.constraints_active = active;
-    status_.constraints_dropped = dropped;
-    if (changed) {
-      status_.command = command.head(status_.command.size());
-      rate_limiter_.setPrevious(status_.command);
-      status_.command_projected = true;
-    }
-    return changed;
+    return constrained_.apply(constraints_, safety_filter_, &status_, &rate_limiter_);
   }
 
   /// The fallback's limits: sat() of (10) (saturateCommand(): euclideanNorm(command) <=
@@ -373,6 +317,7 @@ class FollowerController {
   typename Dims::StateGainMatrix fallback_gain_;            // K_f
   FeedforwardFilter<InputVector> feedforward_filter_;       // (S2)
   CommandRateLimiter<InputVector> rate_limiter_;            // jerk_limit, from u_2(k-1)
+  ConstrainedCommand<Dims> constrained_;                    // (N3), (B3)
   FollowerControllerStatus<Dims> status_;
   InputVector known_feedforward_;  // u_ff + u_r: the command's known inputs of this tick
   bool slot_acting_ = false;       // u_r given at this step
