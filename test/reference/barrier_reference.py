@@ -18,17 +18,19 @@ of (N2) finite and > -a_max, the max_neighbours of smallest h of (N1), ties by d
 target counted among them, then left out), each at a_j = A_n p / ||p|| and rho = perimeter.
 (N3)'s half-spaces themselves are not applied. An agent at p = 0 gives no barrier.
 
-The QP is solved exactly by reference_sim.nearest_point() on the unit normals p / ||p||. If it
-is infeasible: when the first barrier alone does not meet the ball (b_0 / ||g_0|| > a_max),
+The QP is solved exactly by refsim_projection.nearest_point() on the unit normals p / ||p||. If
+it is infeasible: when the first barrier alone does not meet the ball (b_0 / ||g_0|| > a_max),
 u* = a_max g_0 / ||g_0|| (u itself if within 1e-9 a_max of it: the QP's tolerance); otherwise
 the barriers are taken in priority order and each whose addition empties the set with the ball
-is left out (reference_sim.project_command()). A tick
-counts as a barrier tick when u* differs from u, and as infeasible when some barrier was left out.
+is left out (refsim_projection.project_command()). A tick counts as a barrier tick when u*
+differs from u, and as infeasible when some barrier was left out.
 """
 
 import math
 
 import numpy as np
+
+from refsim_projection import nearest_point, project_command
 
 SCHEMA = {"rate": None}
 DEFAULT_RATE = 2.0  # 1/s
@@ -67,7 +69,7 @@ def kept_agents(i, valid, urgency, distance, max_neighbours):
     return [int(j) for j in idx[order]]
 
 
-def filter_command(u, halfspaces, amax, nearest_point, project_command):
+def filter_command(u, halfspaces, amax):
     """(B3) for one follower: (u*, infeasible). halfspaces: (g, b) most urgent first."""
     rows = [(g / np.linalg.norm(g), b / np.linalg.norm(g)) for g, b in halfspaces
             if np.linalg.norm(g) > 0.0]
@@ -85,14 +87,12 @@ def filter_command(u, halfspaces, amax, nearest_point, project_command):
     return x, True
 
 
-def filter_commands(sc, rate, u, X, targets, own_perimeter, a1, known, neighbours,
-                    nearest_point, project_command):
+def filter_commands(sc, rate, u, X, targets, own_perimeter, a1, known, neighbours):
     """Every follower's filtered command this tick: (u* (F, m), changed (F,), infeasible (F,)).
 
     X (F + 1, n) the agents' true states (row 0 the leader); targets (F,) the agent each
     follower looks at; a1 the leader's acceleration (m,), used for a target that is the leader
-    when known; neighbours None, or (N3)'s (params, valid, urgency, distance) of the tick;
-    nearest_point and project_command reference_sim's exact projections.
+    when known; neighbours None, or (N3)'s (params, valid, urgency, distance) of the tick.
     """
     k = sc.k
     amax = sc.acceleration_limit
@@ -116,8 +116,7 @@ def filter_commands(sc, rate, u, X, targets, own_perimeter, a1, known, neighbour
                 a = nb.neighbour_acceleration * p / c if c > 0.0 else np.zeros(k)
                 halfspaces.append(barrier(p, own[k:2 * k] - X[j, k:2 * k], a, nb.perimeter,
                                           rate))
-        x, infeasible[i] = filter_command(u[i], halfspaces, amax, nearest_point,
-                                          project_command)
+        x, infeasible[i] = filter_command(u[i], halfspaces, amax)
         if not np.array_equal(x, u[i]):
             out[i] = x
             changed[i] = True

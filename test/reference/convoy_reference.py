@@ -54,7 +54,11 @@ import numpy as np
 import yaml
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import reference_sim as rs  # noqa: E402  (the scenario parser, beside this file)
+# reference_sim.py's parser and signals, beside this file.
+from refsim_continuous import follower_csv_path, write_csv  # noqa: E402
+from refsim_format import apply_override, as_float, ScenarioError  # noqa: E402
+from refsim_inputs import pulse_sum, sinusoid_sum  # noqa: E402
+from refsim_scenario import build_scenario  # noqa: E402
 from convoy_path import Goal, TargetPath, unit  # noqa: E402
 
 PROG = "convoy_reference"
@@ -80,47 +84,47 @@ class PathParameters:
 def parse_convoy(node):
     """(followers, topology, PathParameters) of the formation section; slots must be path."""
     if not isinstance(node, dict):
-        raise rs.ScenarioError("formation: expected a mapping with slots: path")
+        raise ScenarioError("formation: expected a mapping with slots: path")
     allowed = {"followers", "topology", "shape", "half_angle", "slots", "turning", "path"}
     for key in node:
         if key not in allowed:
-            raise rs.ScenarioError(f"unknown key 'formation.{key}'")
+            raise ScenarioError(f"unknown key 'formation.{key}'")
     if node.get("slots") != "path":
-        raise rs.ScenarioError("formation.slots: this reference covers path only")
+        raise ScenarioError("formation.slots: this reference covers path only")
     if node.get("shape", "line") != "line":
-        raise rs.ScenarioError("formation.shape: path slots need a line")
+        raise ScenarioError("formation.shape: path slots need a line")
     followers = node.get("followers")
     if isinstance(followers, bool) or not isinstance(followers, int) or followers < 1:
-        raise rs.ScenarioError("formation.followers: expected an integer >= 1")
+        raise ScenarioError("formation.followers: expected an integer >= 1")
     topology = node.get("topology", "star")
     if topology not in ("star", "chain"):
-        raise rs.ScenarioError("formation.topology: expected star or chain")
+        raise ScenarioError("formation.topology: expected star or chain")
     pnode = node.get("path") or {}
     if not isinstance(pnode, dict):
-        raise rs.ScenarioError("formation.path: expected a mapping")
+        raise ScenarioError("formation.path: expected a mapping")
     values = {}
     for key in vars(PathParameters()):
         if key not in pnode:
             continue
         if key == "capacity":
             if isinstance(pnode[key], bool) or not isinstance(pnode[key], int) or pnode[key] < 2:
-                raise rs.ScenarioError("formation.path.capacity: expected an integer >= 2")
+                raise ScenarioError("formation.path.capacity: expected an integer >= 2")
             values[key] = pnode[key]
         else:
-            values[key] = rs.as_float(pnode[key], f"formation.path.{key}")
+            values[key] = as_float(pnode[key], f"formation.path.{key}")
     for key in pnode:
         if key not in vars(PathParameters()):
-            raise rs.ScenarioError(f"unknown key 'formation.path.{key}'")
+            raise ScenarioError(f"unknown key 'formation.path.{key}'")
     prm = PathParameters(**values)
     if not (min(prm.spacing, prm.natural_frequency, prm.damping, prm.max_acceleration,
                 prm.braking_acceleration, prm.target_braking, prm.catch_up_speed) > 0.0
             and prm.margin_ratio >= 0.0 and prm.retrace_width >= 0.0):
-        raise rs.ScenarioError("formation.path: values must be > 0 (margin_ratio, "
+        raise ScenarioError("formation.path: values must be > 0 (margin_ratio, "
                                "retrace_width >= 0)")
     if prm.gap_ratio < 1.0 + prm.margin_ratio:
-        raise rs.ScenarioError("formation.path.gap_ratio: must be >= 1 + margin_ratio")
+        raise ScenarioError("formation.path.gap_ratio: must be >= 1 + margin_ratio")
     if prm.braking_acceleration > prm.max_acceleration:
-        raise rs.ScenarioError("formation.path.braking_acceleration: exceeds max_acceleration")
+        raise ScenarioError("formation.path.braking_acceleration: exceeds max_acceleration")
     return followers, topology, prm
 
 
@@ -130,15 +134,15 @@ def load(path, overrides):
         with open(path, encoding="utf-8") as fh:
             raw = yaml.safe_load(fh) or {}
     except (OSError, yaml.YAMLError) as exc:
-        raise rs.ScenarioError(f"cannot read {path}: {exc}") from None
+        raise ScenarioError(f"cannot read {path}: {exc}") from None
     for assignment in overrides:
-        rs.apply_override(raw, assignment)
+        apply_override(raw, assignment)
     formation = parse_convoy(raw.pop("formation", None))
-    sc = rs.build_scenario(raw)
+    sc = build_scenario(raw)
     if not sc.double_integrator:
-        raise rs.ScenarioError("model.type: path slots need a double_integrator")
+        raise ScenarioError("model.type: path slots need a double_integrator")
     if sc.info_command or sc.info_estimator:
-        raise rs.ScenarioError("controller.leader_information: must be false with path slots")
+        raise ScenarioError("controller.leader_information: must be false with path slots")
     return (sc,) + formation
 
 
@@ -205,7 +209,7 @@ def advance_leader(sc, x, t, u1, T):
                                 if t < e < t + T})
     x = x.copy()
     for a, b in zip(cuts[:-1], cuts[1:]):
-        ud = rs.pulse_sum(sc.disturbances, 0.5 * (a + b), sc.n)[:, 0]
+        ud = pulse_sum(sc.disturbances, 0.5 * (a + b), sc.n)[:, 0]
         dt, acc = b - a, u1 + ud[k:]
         x[:k] = x[:k] + x[k:] * dt + 0.5 * dt * dt * acc + ud[:k] * dt
         x[k:] = x[k:] + acc * dt
@@ -231,7 +235,7 @@ def simulate(sc, followers, topology, prm):
     leader = sc.x1_0.copy()
     rows = [[] for _ in range(followers)]
     grid = np.arange(ticks + 1) / sc.control_rate
-    inputs = rs.pulse_sum(sc.input_pulses, grid, sc.m) + rs.sinusoid_sum(sc.sinusoids, grid, sc.m)
+    inputs = pulse_sum(sc.input_pulses, grid, sc.m) + sinusoid_sum(sc.sinusoids, grid, sc.m)
     for tick in range(ticks + 1):
         t, u1 = grid[tick], inputs[:, tick]
         commands = []
@@ -286,7 +290,7 @@ def main(argv=None):
     args = ap.parse_args(argv)
     try:
         sc, followers, topology, prm = load(args.scenario, args.overrides)
-    except rs.ScenarioError as exc:
+    except ScenarioError as exc:
         print(f"{PROG}: error: {exc}", file=sys.stderr)
         return 2
     wall0 = time.perf_counter()
@@ -294,7 +298,7 @@ def main(argv=None):
     wall = time.perf_counter() - wall0
     for name, target, d_i, cols in runs:
         if args.csv:
-            rs.write_csv(rs.follower_csv_path(args.csv, name), cols)
+            write_csv(follower_csv_path(args.csv, name), cols)
         line = " ".join(f"{key}={value:.9g}" for key, value in
                         summary(sc, d_i, cols, wall).items())
         print(f"{name} target={target} {line}", flush=True)
