@@ -95,8 +95,8 @@ SafetyFilterResult SafetyFilter::filter(const Eigen::Vector3d& nominal,
   // already that one within the QP's tolerance (saturated along g_0) is kept as it is.
   if ((qp.dropped_mask & 1U) != 0U) {
     const Eigen::Vector3d best = bestEffort(first_normal_, acceleration_limit);
-    result.changed = euclideanNorm(best - u) >
-                     CommandProjection::kFeasibilityTolerance * acceleration_limit;
+    result.changed =
+        euclideanNorm(best - u) > CommandProjection::kFeasibilityTolerance * acceleration_limit;
     result.command = result.changed ? best : u;
     result.active = -1;
     result.active_count = 0;
