@@ -13,33 +13,14 @@
 set -euo pipefail
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 root=$(cd "$here/../.." && pwd)
-reps=5
-min_time=0.1
-out=$root/doc
-while [ $# -gt 0 ]; do
-  case "$1" in
-    --reps) reps=$2; shift 2 ;;
-    --min-time) min_time=$2; shift 2 ;;
-    -*) echo "usage: $0 [--reps N] [--min-time S] [OUT_DIR]" >&2; exit 2 ;;
-    *) out=$1; shift ;;
-  esac
-done
-
-if [[ -z ${BENCHMARK:-} ]]; then
-  build_dir=${BUILD_DIR:-$root/build}
-  BUILD_DIR=$build_dir "$root/scripts/build.sh" >/dev/null
-  BENCHMARK=$build_dir/devel/lib/projection_collision_avoidance/benchmark_neighbours
-fi
-test -x "$BENCHMARK" || {
-  echo "neighbours cpu: no benchmark_neighbours at $BENCHMARK (libbenchmark-dev installed?)" >&2
-  exit 1
-}
+# shellcheck source=experiments/common/benchmark_run.bash
+source "$root/experiments/common/benchmark_run.bash"
+cpu_arguments "$root" "$@"
 
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 echo "neighbours cpu: $reps repetitions of every case, at least $min_time s each" >&2
-"$BENCHMARK" --benchmark_repetitions="$reps" --benchmark_min_time="$min_time" \
-  --benchmark_format=json >"$work/benchmark.json"
+run_benchmark "neighbours cpu" benchmark_neighbours "$root" "$work/benchmark.json"
 /usr/bin/python3 "$here/neighbours_cpu.py" "$work/benchmark.json" "$out" --date "$(date +%F)" \
   --min-time "$min_time"
 echo "neighbours cpu: wrote $out/neighbours_cpu.csv, neighbours_cpu.md, neighbours_cpu.png"
